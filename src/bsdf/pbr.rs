@@ -1,0 +1,81 @@
+//! glTF 2.0 metallic-roughness as a BSDF: a blend, by `metallic`, of a GGX conductor whose
+//! Fresnel is Schlick's with F0 = base colour, and a rough plastic (IOR 1.5) whose diffuse base
+//! has the base colour. Both lobes share the roughness alpha = roughness^2.
+
+use super::{BsdfSample, Conductor, ConductorFresnel, Ggx, Plastic, PlasticTables};
+use crate::color::Rgb;
+use glam::{Vec2, Vec3};
+
+/// The glTF metallic-roughness model at a surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct Pbr<'a> {
+    /// Base colour (albedo of the dielectric, F0 of the metal).
+    pub base_color: Rgb,
+    /// Metalness in [0, 1].
+    pub metallic: f32,
+    /// GGX alpha (roughness squared).
+    pub alpha: f32,
+    /// Interface albedos of the IOR-1.5 coating over the alpha grid.
+    pub tables: &'a PlasticTables,
+}
+
+impl Pbr<'_> {
+    fn metal(&self) -> Conductor {
+        Conductor {
+            ggx: Some(Ggx::new(self.alpha, self.alpha)),
+            fresnel: ConductorFresnel::Schlick { f0: self.base_color },
+            specular_reflectance: Rgb::ONE,
+        }
+    }
+
+    fn dielectric(&self) -> Plastic<'_> {
+        Plastic {
+            diffuse_reflectance: self.base_color,
+            specular_reflectance: Rgb::ONE,
+            alpha: self.alpha,
+            tables: self.tables,
+        }
+    }
+
+    /// metallic f_metal + (1 - metallic) f_dielectric, times |cos theta_i|.
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let m = self.metallic;
+        let mut f = Rgb::ZERO;
+        if m > 0.0 {
+            f += self.metal().eval(wo, wi) * m;
+        }
+        if m < 1.0 {
+            f += self.dielectric().eval(wo, wi) * (1.0 - m);
+        }
+        f
+    }
+
+    /// The same blend of the two lobes' densities.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let m = self.metallic;
+        let mut p = 0.0;
+        if m > 0.0 {
+            p += self.metal().pdf(wo, wi) * m;
+        }
+        if m < 1.0 {
+            p += self.dielectric().pdf(wo, wi) * (1.0 - m);
+        }
+        p
+    }
+
+    /// Choose the metal with probability `metallic`, sample it, weight by the whole blend.
+    pub fn sample(&self, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let m = self.metallic;
+        let wi = if u1 < m {
+            self.metal().sample(wo, u2)?.wi
+        } else {
+            let u1 = if m > 0.0 { ((u1 - m) / (1.0 - m)).clamp(0.0, 1.0 - f32::EPSILON) } else { u1 };
+            self.dielectric().sample(wo, u1, u2)?.wi
+        };
+        let pdf = self.pdf(wo, wi);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false, eta: 1.0 })
+    }
+}

@@ -1,0 +1,212 @@
+//! Indexed triangle meshes, as loaded from OBJ/glTF or built procedurally.
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    /// Smallest corner.
+    pub min: Vec3,
+    /// Largest corner.
+    pub max: Vec3,
+}
+
+impl Bounds {
+    /// The empty box (min = +inf, max = -inf), the identity of [`Bounds::union`].
+    pub const EMPTY: Bounds = Bounds { min: Vec3::INFINITY, max: Vec3::NEG_INFINITY };
+
+    /// Grow to contain `p`.
+    pub fn include(&mut self, p: Vec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    /// The smallest box containing both.
+    pub fn union(self, other: Bounds) -> Bounds {
+        Bounds { min: self.min.min(other.min), max: self.max.max(other.max) }
+    }
+
+    /// True when nothing was included.
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+
+    /// Centre and radius of the bounding sphere through the box corners.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        if self.is_empty() {
+            return (Vec3::ZERO, 0.0);
+        }
+        let c = (self.min + self.max) * 0.5;
+        (c, (self.max - c).length())
+    }
+}
+
+/// A triangle mesh with optional per-vertex normals and texture coordinates.
+///
+/// Texture coordinates follow DESIGN.md section 3: origin at the bottom-left, v up (OBJ `vt`);
+/// loaders convert other conventions (glTF's top-left origin) on load.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleMesh {
+    /// Vertex positions (world space once the scene is loaded).
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals, if the file has them.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, if the file has them.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Vertex indices, three per triangle, counter-clockwise seen from the front.
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// What [`TriangleMesh::validate`] removed or found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MeshCleanup {
+    /// Triangles of zero area (or with a repeated vertex) that were dropped.
+    pub degenerate_triangles: usize,
+}
+
+impl TriangleMesh {
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// The three vertex positions of triangle `i`.
+    #[inline]
+    pub fn triangle(&self, i: usize) -> [Vec3; 3] {
+        let [a, b, c] = self.indices[i];
+        [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]
+    }
+
+    /// Area of triangle `i`.
+    pub fn triangle_area(&self, i: usize) -> f32 {
+        let [a, b, c] = self.triangle(i);
+        0.5 * (b - a).cross(c - a).length()
+    }
+
+    /// Bounding box of all vertices.
+    pub fn bounds(&self) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        for &p in &self.positions {
+            b.include(p);
+        }
+        b
+    }
+
+    /// Apply an affine transform: positions by `m`, normals by its inverse transpose.
+    pub fn transform(&mut self, m: &Mat4) {
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        if let Some(normals) = &mut self.normals {
+            let nm = Mat3::from_mat4(*m).inverse().transpose();
+            for n in normals {
+                *n = (nm * *n).normalize_or_zero();
+            }
+        }
+        // A mirroring transform turns the winding around; restore counter-clockwise fronts.
+        if m.determinant() < 0.0 {
+            for t in &mut self.indices {
+                t.swap(1, 2);
+            }
+        }
+    }
+
+    /// Check the mesh for unusable data and drop degenerate triangles.
+    ///
+    /// Errors (returned as a message for the caller to attach the file name to): non-finite
+    /// positions, normals or texture coordinates, indices out of range, attribute arrays whose
+    /// length differs from the vertex count, and a mesh with no triangle left.
+    /// Zero-area triangles are removed and counted: they cannot be hit and have no normal.
+    pub fn validate(&mut self) -> Result<MeshCleanup, String> {
+        let n = self.positions.len();
+        if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!("vertex {i} has a non-finite position {}", self.positions[i]));
+        }
+        if let Some(normals) = &self.normals {
+            if normals.len() != n {
+                return Err(format!("{} normals for {n} vertices", normals.len()));
+            }
+            if let Some(i) = normals.iter().position(|v| !v.is_finite()) {
+                return Err(format!("vertex {i} has a non-finite normal {}", normals[i]));
+            }
+        }
+        if let Some(uvs) = &self.uvs {
+            if uvs.len() != n {
+                return Err(format!("{} texture coordinates for {n} vertices", uvs.len()));
+            }
+            if let Some(i) = uvs.iter().position(|v| !v.is_finite()) {
+                return Err(format!("vertex {i} has non-finite texture coordinates {}", uvs[i]));
+            }
+        }
+        for (i, tri) in self.indices.iter().enumerate() {
+            if let Some(&bad) = tri.iter().find(|&&v| v as usize >= n) {
+                return Err(format!("triangle {i} refers to vertex {bad}, but there are only {n} vertices"));
+            }
+        }
+        let before = self.indices.len();
+        let positions = &self.positions;
+        self.indices.retain(|&[a, b, c]| {
+            let (a, b, c) = (positions[a as usize], positions[b as usize], positions[c as usize]);
+            let area2 = (b - a).cross(c - a).length_squared();
+            area2 > 0.0 && area2.is_finite()
+        });
+        let cleanup = MeshCleanup { degenerate_triangles: before - self.indices.len() };
+        if self.indices.is_empty() {
+            return Err(if before == 0 {
+                "the mesh has no triangles".to_string()
+            } else {
+                format!("all {before} triangles have zero area")
+            });
+        }
+        Ok(cleanup)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> TriangleMesh {
+        TriangleMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            normals: None,
+            uvs: None,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    #[test]
+    fn mesh_validate_drops_zero_area_triangles() {
+        let mut m = quad();
+        m.indices.push([0, 0, 1]);
+        m.indices.push([0, 1, 1]);
+        assert_eq!(m.validate().unwrap().degenerate_triangles, 2);
+        assert_eq!(m.triangle_count(), 2);
+    }
+
+    #[test]
+    fn mesh_validate_rejects_bad_data() {
+        let mut m = quad();
+        m.positions[2].y = f32::NAN;
+        assert!(m.validate().unwrap_err().contains("non-finite position"));
+        let mut m = quad();
+        m.indices.push([0, 1, 7]);
+        assert!(m.validate().unwrap_err().contains("vertex 7"));
+        let mut m = quad();
+        m.indices = vec![[0, 1, 1]];
+        assert!(m.validate().unwrap_err().contains("zero area"));
+        let mut m = quad();
+        m.indices.clear();
+        assert!(m.validate().unwrap_err().contains("no triangles"));
+    }
+
+    #[test]
+    fn mesh_mirror_transform_keeps_front_faces() {
+        let mut m = quad();
+        m.normals = Some(vec![Vec3::Z; 4]);
+        m.transform(&Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        let [a, b, c] = m.triangle(0);
+        assert!((b - a).cross(c - a).z > 0.0);
+        assert_eq!(m.normals.unwrap()[0], Vec3::Z);
+    }
+}

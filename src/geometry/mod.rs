@@ -1,0 +1,31 @@
+//! Geometry: rays with differentials, shading frames, triangle meshes and the surface
+//! interaction at a ray hit. Conventions (DESIGN.md section 3): right-handed world, y up;
+//! texture coordinates with the origin at the bottom-left, v up.
+
+mod frame;
+mod interaction;
+mod mesh;
+pub mod obj;
+mod ray;
+pub mod shapes;
+
+pub use frame::Frame;
+pub use interaction::{SurfaceInteraction, TriangleVertices};
+pub use mesh::{Bounds, TriangleMesh};
+pub use ray::{Ray, RayDifferential};
+
+use glam::Vec3;
+
+/// Offset a point along the geometric normal `ng`, to the side of direction `w`, far enough
+/// that a ray leaving it does not hit its own surface again.
+///
+/// The distance scales with the point's magnitude, as Mitsuba 3's `offset_p` does: float
+/// positions carry a relative error of a few ulps, so a fixed epsilon fails far from the origin.
+#[inline]
+pub fn offset_ray_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+    /// Relative offset: 2^-24 (half an ulp of 1) times 1500, Mitsuba 3's `RayEpsilon`.
+    const RAY_EPSILON: f32 = 1500.0 / 16_777_216.0;
+    let magnitude = (1.0 + p.abs().max_element()) * RAY_EPSILON;
+    let side = if ng.dot(w) >= 0.0 { magnitude } else { -magnitude };
+    p + ng * side
+}

@@ -1,0 +1,73 @@
+//! A float image with 1 to 4 channels.
+
+use glam::Vec4;
+
+/// How the integer values of an image file encode colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ColorSpace {
+    /// sRGB-encoded: 8- and 16-bit colour channels are decoded to linear on load.
+    Srgb,
+    /// Values are used as stored (data textures: normals, roughness, F maps).
+    Linear,
+}
+
+/// A row-major float image, row 0 at the top, `channels` interleaved values per pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bitmap {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// Values per pixel: 1 (grey), 2 (grey + alpha), 3 (RGB) or 4 (RGBA).
+    pub channels: usize,
+    /// `width * height * channels` values.
+    pub data: Vec<f32>,
+}
+
+impl Bitmap {
+    /// An image filled with zeros.
+    pub fn new(width: usize, height: usize, channels: usize) -> Self {
+        assert!((1..=4).contains(&channels));
+        Bitmap { width, height, channels, data: vec![0.0; width * height * channels] }
+    }
+
+    /// The pixel at column `x`, row `y` as RGBA: grey is replicated, missing alpha is 1.
+    #[inline]
+    pub fn pixel(&self, x: usize, y: usize) -> Vec4 {
+        let i = (y * self.width + x) * self.channels;
+        let d = &self.data[i..i + self.channels];
+        match self.channels {
+            1 => Vec4::new(d[0], d[0], d[0], 1.0),
+            2 => Vec4::new(d[0], d[0], d[0], d[1]),
+            3 => Vec4::new(d[0], d[1], d[2], 1.0),
+            _ => Vec4::new(d[0], d[1], d[2], d[3]),
+        }
+    }
+
+    /// The values of pixel (x, y).
+    #[inline]
+    pub fn values(&self, x: usize, y: usize) -> &[f32] {
+        let i = (y * self.width + x) * self.channels;
+        &self.data[i..i + self.channels]
+    }
+
+    /// Mutable values of pixel (x, y).
+    #[inline]
+    pub fn values_mut(&mut self, x: usize, y: usize) -> &mut [f32] {
+        let i = (y * self.width + x) * self.channels;
+        &mut self.data[i..i + self.channels]
+    }
+
+    /// Mean of each channel.
+    pub fn channel_means(&self) -> Vec<f64> {
+        let mut sums = vec![0.0f64; self.channels];
+        for px in self.data.chunks_exact(self.channels) {
+            for (s, v) in sums.iter_mut().zip(px) {
+                *s += *v as f64;
+            }
+        }
+        let n = (self.width * self.height).max(1) as f64;
+        sums.iter().map(|s| s / n).collect()
+    }
+}

@@ -1,0 +1,262 @@
+//! Reading and writing image files. Writes go to a temporary file beside the target and are
+//! renamed over it only when complete, so a failed or interrupted write never replaces a good
+//! image with a partial one.
+
+use super::{Bitmap, ColorSpace};
+use crate::color::{linear_to_srgb, srgb_to_linear, srgb_u8_table};
+use crate::error::{Error, Result};
+use std::path::{Path, PathBuf};
+
+/// Output file formats, chosen by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// OpenEXR, 32-bit float, linear.
+    Exr,
+    /// PNG, 8-bit sRGB, clamped to [0, 1].
+    Png,
+}
+
+impl OutputFormat {
+    /// The format of `path` from its extension.
+    pub fn from_path(path: &Path) -> Result<Self> {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("exr") => Ok(OutputFormat::Exr),
+            Some("png") => Ok(OutputFormat::Png),
+            _ => Err(Error::image(path, "the output must end in .exr (linear) or .png (sRGB)")),
+        }
+    }
+}
+
+/// Read an image file as floats. Integer colour channels are divided by their maximum and,
+/// with [`ColorSpace::Srgb`], sRGB-decoded (alpha never is); float files (EXR, HDR) are linear
+/// whatever `space` says. Negative values (lossy EXR compression) and non-finite ones become 0.
+pub fn read_bitmap(path: &Path, space: ColorSpace) -> Result<Bitmap> {
+    let is_exr = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let mut bitmap = if is_exr { read_exr(path)? } else { read_with_image_crate(path, space)? };
+    for v in &mut bitmap.data {
+        if !(v.is_finite() && *v >= 0.0) {
+            *v = 0.0;
+        }
+    }
+    if bitmap.width == 0 || bitmap.height == 0 {
+        return Err(Error::image(path, "the image is empty"));
+    }
+    Ok(bitmap)
+}
+
+fn read_with_image_crate(path: &Path, space: ColorSpace) -> Result<Bitmap> {
+    use ::image::DynamicImage;
+    let reader = ::image::ImageReader::open(path)
+        .map_err(|e| Error::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?;
+    let decoded = reader.decode().map_err(|e| Error::image(path, format!("cannot decode: {e}")))?;
+    let (w, h) = (decoded.width() as usize, decoded.height() as usize);
+    let srgb = space == ColorSpace::Srgb;
+    // Integer formats: (channels, has alpha, values scaled to [0, 1]).
+    let (channels, values): (usize, Vec<f32>) = match decoded {
+        DynamicImage::ImageLuma8(i) => (1, i.into_raw().into_iter().map(|v| v as f32 / 255.0).collect()),
+        DynamicImage::ImageLumaA8(i) => (2, i.into_raw().into_iter().map(|v| v as f32 / 255.0).collect()),
+        DynamicImage::ImageRgb8(i) => (3, i.into_raw().into_iter().map(|v| v as f32 / 255.0).collect()),
+        DynamicImage::ImageRgba8(i) => (4, i.into_raw().into_iter().map(|v| v as f32 / 255.0).collect()),
+        DynamicImage::ImageLuma16(i) => (1, i.into_raw().into_iter().map(|v| v as f32 / 65535.0).collect()),
+        DynamicImage::ImageLumaA16(i) => (2, i.into_raw().into_iter().map(|v| v as f32 / 65535.0).collect()),
+        DynamicImage::ImageRgb16(i) => (3, i.into_raw().into_iter().map(|v| v as f32 / 65535.0).collect()),
+        DynamicImage::ImageRgba16(i) => (4, i.into_raw().into_iter().map(|v| v as f32 / 65535.0).collect()),
+        DynamicImage::ImageRgb32F(i) => {
+            return Ok(Bitmap { width: w, height: h, channels: 3, data: i.into_raw() });
+        }
+        DynamicImage::ImageRgba32F(i) => {
+            return Ok(Bitmap { width: w, height: h, channels: 4, data: i.into_raw() });
+        }
+        other => {
+            let i = other.to_rgba32f();
+            return Ok(Bitmap { width: w, height: h, channels: 4, data: i.into_raw() });
+        }
+    };
+    let mut data = values;
+    if srgb {
+        srgb_decode_colors(&mut data, channels);
+    }
+    Ok(Bitmap { width: w, height: h, channels, data })
+}
+
+/// sRGB-decode the colour channels (not alpha) of interleaved integer-sourced values in [0, 1].
+pub(crate) fn srgb_decode_colors(data: &mut [f32], channels: usize) {
+    let color_channels = if channels == 2 || channels == 4 { channels - 1 } else { channels };
+    let table = srgb_u8_table();
+    for px in data.chunks_exact_mut(channels) {
+        for v in &mut px[..color_channels] {
+            // Exact table for 8-bit values, the formula otherwise.
+            let byte = (*v * 255.0).round();
+            *v = if (byte / 255.0 - *v).abs() < 1e-7 { table[byte as usize] } else { srgb_to_linear(*v) };
+        }
+    }
+}
+
+fn read_exr(path: &Path) -> Result<Bitmap> {
+    use exr::prelude::traits::*;
+    if let Err(e) = std::fs::metadata(path) {
+        return Err(Error::io(path, e));
+    }
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| Error::image(path, format!("cannot read OpenEXR: {e}")))?;
+    let layer = image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let channels = &layer.channel_data.list;
+    let find = |name: &str| channels.iter().position(|c| c.name.to_string().eq_ignore_ascii_case(name));
+    // RGB(A) by name; else luminance; else the first four channels in the file's (sorted) order.
+    let order: Vec<usize> = match (find("R"), find("G"), find("B"), find("Y")) {
+        (Some(r), Some(g), Some(b), _) => [Some(r), Some(g), Some(b), find("A")].into_iter().flatten().collect(),
+        (_, _, _, Some(y)) => [Some(y), find("A")].into_iter().flatten().collect(),
+        _ => (0..channels.len().min(4)).collect(),
+    };
+    if order.is_empty() {
+        return Err(Error::image(path, "the OpenEXR file has no channels"));
+    }
+    let planes: Vec<Vec<f32>> = order.iter().map(|&i| channels[i].sample_data.values_as_f32().collect()).collect();
+    let n = order.len();
+    let mut data = vec![0.0; w * h * n];
+    for (c, plane) in planes.iter().enumerate() {
+        for (p, v) in plane.iter().enumerate() {
+            data[p * n + c] = *v;
+        }
+    }
+    Ok(Bitmap { width: w, height: h, channels: n, data })
+}
+
+/// A temporary path beside `path`, in the same directory so that the rename is atomic.
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
+}
+
+/// Write through a temporary file, then rename it over `path`.
+fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+    let tmp = temporary_path(path);
+    match write(&tmp) {
+        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            Error::io(path, e)
+        }),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}
+
+/// Write named float channels (each `width * height` values, row 0 at the top) to an OpenEXR
+/// file (32-bit float, ZIP compression).
+pub fn write_exr(path: &Path, width: usize, height: usize, channels: Vec<(String, Vec<f32>)>) -> Result<()> {
+    use exr::prelude::traits::*;
+    use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec};
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> =
+        channels.into_iter().map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::F32(values))).collect();
+    let layer = Layer::new(
+        (width, height),
+        LayerAttributes::named("tessera"),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let image = Image::from_layer(layer);
+    write_atomically(path, |tmp| {
+        image.write().to_file(tmp).map_err(|e| match e {
+            exr::error::Error::Io(io) => Error::io(path, io),
+            other => Error::image(path, format!("cannot write OpenEXR: {other}")),
+        })
+    })
+}
+
+/// Write an RGB bitmap as an 8-bit sRGB PNG (values clamped to [0, 1]).
+pub fn write_png(path: &Path, rgb: &Bitmap) -> Result<()> {
+    assert_eq!(rgb.channels, 3);
+    let bytes: Vec<u8> = rgb.data.iter().map(|&v| (linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8).collect();
+    let img = ::image::RgbImage::from_raw(rgb.width as u32, rgb.height as u32, bytes).expect("buffer size matches");
+    write_atomically(path, |tmp| {
+        img.save_with_format(tmp, ::image::ImageFormat::Png).map_err(|e| match e {
+            ::image::ImageError::IoError(io) => Error::io(path, io),
+            other => Error::image(path, format!("cannot write PNG: {other}")),
+        })
+    })
+}
+
+/// Write an RGB image and optional extra bitmaps (named channel groups, EXR only) in the format
+/// of `path`'s extension. PNG keeps only the RGB image.
+pub fn write_image(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)]) -> Result<()> {
+    match OutputFormat::from_path(path)? {
+        OutputFormat::Png => write_png(path, rgb),
+        OutputFormat::Exr => {
+            let mut channels = Vec::new();
+            let mut push = |names: &[&str], b: &Bitmap| {
+                for (c, name) in names.iter().enumerate() {
+                    channels.push((name.to_string(), b.data.iter().skip(c).step_by(b.channels).copied().collect()));
+                }
+            };
+            push(&["R", "G", "B"], rgb);
+            for (names, b) in extra {
+                push(names, b);
+            }
+            write_exr(path, rgb.width, rgb.height, channels)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trip_is_exact() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        let mut b = Bitmap::new(3, 2, 3);
+        for (i, v) in b.data.iter_mut().enumerate() {
+            *v = i as f32 * 0.37 + 0.001;
+        }
+        write_image(&path, &b, &[]).unwrap();
+        let back = read_bitmap(&path, ColorSpace::Linear).unwrap();
+        assert_eq!(back, b);
+        // No temporary file is left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn png_srgb_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.png");
+        let mut b = Bitmap::new(2, 1, 3);
+        b.data = vec![0.577_581, 0.021_219, 1.0, 0.0, 0.5, 2.0];
+        write_image(&path, &b, &[]).unwrap();
+        let back = read_bitmap(&path, ColorSpace::Srgb).unwrap();
+        // 200/255 and 40/255 decode to exactly these values (Mitsuba's numbers); 2.0 clamps.
+        let expected = [0.577_581, 0.021_219, 1.0, 0.0, 0.5, 1.0];
+        for (a, e) in back.data.iter().zip(expected) {
+            assert!((a - e).abs() < 4e-3, "{a} vs {e}");
+        }
+        assert!((back.data[0] - 0.577_581).abs() < 1e-5);
+    }
+
+    #[test]
+    fn failed_write_keeps_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("keep.exr");
+        std::fs::write(&path, b"good").unwrap();
+        let result = write_atomically(&path, |_| Err(Error::image(&path, "simulated failure")));
+        assert!(result.is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), b"good");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn output_format_from_extension() {
+        assert_eq!(OutputFormat::from_path(Path::new("a.EXR")).unwrap(), OutputFormat::Exr);
+        assert!(OutputFormat::from_path(Path::new("a.jpg")).is_err());
+    }
+}

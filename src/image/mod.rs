@@ -1,0 +1,12 @@
+//! Images: the float bitmap type, reading textures (PNG, JPEG, Radiance HDR, OpenEXR), writing
+//! renders (EXR linear, PNG sRGB) without ever leaving a partial file, and the film that
+//! accumulates samples.
+
+mod bitmap;
+mod film;
+mod io;
+
+pub use bitmap::{Bitmap, ColorSpace};
+pub use film::{Aov, Film, PixelSum};
+pub(crate) use io::srgb_decode_colors;
+pub use io::{OutputFormat, read_bitmap, write_exr, write_image, write_png};

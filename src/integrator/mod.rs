@@ -1,0 +1,107 @@
+//! Rendering an image: tiles in parallel (rayon), each pixel's samples in a fixed order, so the
+//! image is bit-identical whatever the number of threads.
+
+mod path;
+
+pub use path::{FirstHit, PathTracer};
+
+use crate::color::Rgb;
+use crate::image::{Aov, Film, PixelSum};
+use crate::sampling::Sampler;
+use crate::scene::Scene;
+use glam::Vec2;
+use rayon::prelude::*;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Side of the square tiles work is split into.
+const TILE: u32 = 16;
+
+/// A rectangle of pixels `[x0, x1) x [y0, y1)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl Crop {
+    /// The whole image.
+    pub fn full(width: u32, height: u32) -> Self {
+        Crop { x0: 0, y0: 0, x1: width, y1: height }
+    }
+
+    /// Size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.x1 - self.x0, self.y1 - self.y0)
+    }
+}
+
+fn aov_values(aovs: &[Aov], hit: &Option<path::FirstHit>, out: &mut [f32]) {
+    let mut i = 0;
+    let Some(h) = hit else {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        return;
+    };
+    for a in aovs {
+        let values: &[f32] = match a {
+            Aov::Albedo => &h.albedo.to_array(),
+            Aov::Normal => &h.normal.to_array(),
+            Aov::Uv => &h.uv.to_array(),
+            Aov::Footprint => &[h.footprint],
+        };
+        out[i..i + values.len()].copy_from_slice(values);
+        i += values.len();
+    }
+}
+
+/// Render the pixels of `crop` (default: the whole image) with the scene's settings, recording
+/// `aovs`. `progress(done, total)` is called as samples complete (from worker threads).
+/// Runs on the current rayon thread pool.
+pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn Fn(u64, u64) + Sync)) -> Film {
+    let s = scene.settings;
+    let crop = crop.unwrap_or(Crop::full(s.width, s.height));
+    let (w, h) = crop.size();
+    let film = Mutex::new(Film::new(w as usize, h as usize, aovs));
+    let stride = film.lock().expect("fresh").aov_stride();
+    let tracer = PathTracer::new(scene);
+    let total = w as u64 * h as u64 * s.spp as u64;
+    let done = AtomicU64::new(0);
+    let tiles: Vec<(u32, u32)> =
+        (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty))).collect();
+    tiles.par_iter().for_each(|&(tx, ty)| {
+        let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
+        let mut aov_buf = vec![0.0f32; stride];
+        for fy in ty * TILE..((ty + 1) * TILE).min(h) {
+            for fx in tx * TILE..((tx + 1) * TILE).min(w) {
+                let (px, py) = (crop.x0 + fx, crop.y0 + fy);
+                let pixel_index = py as u64 * s.width as u64 + px as u64;
+                let mut sum = PixelSum::new(stride);
+                for i in 0..s.spp {
+                    let mut sampler = Sampler::new(s.seed, pixel_index, i);
+                    let film_pos = Vec2::new(px as f32, py as f32) + sampler.next_2d();
+                    let (ray, diff) = scene.camera.generate_ray(film_pos);
+                    let mut first_hit = None;
+                    let l = tracer.trace(ray, &diff, &mut sampler, &mut first_hit);
+                    aov_values(aovs, &first_hit, &mut aov_buf);
+                    sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), &aov_buf);
+                }
+                pixels.push((fx as usize, fy as usize, sum));
+            }
+        }
+        let samples = pixels.len() as u64 * s.spp as u64;
+        {
+            let mut film = film.lock().expect("no panics while holding the film");
+            for (x, y, sum) in pixels {
+                film.set_pixel(x, y, sum);
+            }
+        }
+        progress(done.fetch_add(samples, Ordering::Relaxed) + samples, total);
+    });
+    film.into_inner().expect("no panics while holding the film")
+}

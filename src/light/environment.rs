@@ -1,0 +1,177 @@
+//! The environment: light arriving from infinitely far away, constant or from an
+//! equirectangular (latitude-longitude) map, importance-sampled by luminance.
+//!
+//! Mapping (DESIGN.md section 3, Mitsuba 3's `envmap` with identity transform): a direction d
+//! towards the sky has u = atan2(d.x, -d.z) / 2 pi wrapped to [0, 1) and v = acos(d.y) / pi. The
+//! map is read bilinearly at column u W - 0.5 (periodic) and row v (H - 1) (clamped): row 0 is
+//! the zenith, the last row the nadir, the centre column faces +z and u = 0.25 faces +x.
+
+use super::LightSample;
+use crate::color::{Rgb, luminance};
+use crate::image::Bitmap;
+use crate::sampling::{Distribution2D, warp};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Environment lighting.
+#[derive(Clone, Debug)]
+pub enum Environment {
+    /// The same radiance from every direction (Mitsuba's `constant`), sampled uniformly.
+    Constant(Rgb),
+    /// An equirectangular map.
+    Map(EnvironmentMap),
+}
+
+/// An equirectangular environment map with its sampling distribution.
+#[derive(Clone, Debug)]
+pub struct EnvironmentMap {
+    image: Bitmap,
+    scale: f32,
+    /// Over (u, v) cells of the image's resolution, proportional to luminance times sin(theta).
+    distribution: Distribution2D,
+}
+
+/// (u, v) of a unit direction.
+#[inline]
+fn direction_to_uv(d: Vec3) -> Vec2 {
+    let u = d.x.atan2(-d.z) / (2.0 * PI);
+    let u = if u < 0.0 { u + 1.0 } else { u };
+    Vec2::new(u.min(1.0 - f32::EPSILON), d.y.clamp(-1.0, 1.0).acos() / PI)
+}
+
+/// Unit direction of (u, v).
+#[inline]
+fn uv_to_direction(uv: Vec2) -> Vec3 {
+    let (sin_t, cos_t) = (uv.y * PI).sin_cos();
+    let (sin_p, cos_p) = (uv.x * 2.0 * PI).sin_cos();
+    Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p)
+}
+
+impl EnvironmentMap {
+    /// A map from an RGB(A) image, its radiance multiplied by `scale`.
+    pub fn new(image: Bitmap, scale: f32) -> Self {
+        let (w, h) = (image.width, image.height);
+        let mut weights = vec![0.0f32; w * h];
+        let mut map = EnvironmentMap { image, scale, distribution: Distribution2D::new(&[1.0], 1, 1) };
+        for j in 0..h {
+            let v = (j as f32 + 0.5) / h as f32;
+            let sin_theta = (v * PI).sin();
+            for i in 0..w {
+                // Luminance at the cell centre and its four corners: cells bridging a bright
+                // texel keep a share of the samples.
+                let corners = [(0.5, 0.5), (0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
+                let lum = corners
+                    .iter()
+                    .map(|(du, dv)| {
+                        let uv = Vec2::new((i as f32 + du) / w as f32, ((j as f32 + dv) / h as f32).min(1.0));
+                        luminance(map.lookup_uv(uv))
+                    })
+                    .fold(0.0f32, f32::max);
+                weights[j * w + i] = lum * sin_theta;
+            }
+        }
+        map.distribution = Distribution2D::new(&weights, w, h);
+        map
+    }
+
+    /// Bilinear radiance at (u, v).
+    fn lookup_uv(&self, uv: Vec2) -> Rgb {
+        let (w, h) = (self.image.width, self.image.height);
+        let x = uv.x * w as f32 - 0.5;
+        let y = (uv.y * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let col = |c: f32| (c as i64).rem_euclid(w as i64) as usize;
+        let (c0, c1) = (col(x0), col(x0 + 1.0));
+        let r0 = y0 as usize;
+        let r1 = (r0 + 1).min(h - 1);
+        let px = |c: usize, r: usize| self.image.pixel(c, r).truncate();
+        let top = px(c0, r0) * (1.0 - fx) + px(c1, r0) * fx;
+        let bottom = px(c0, r1) * (1.0 - fx) + px(c1, r1) * fx;
+        (top * (1.0 - fy) + bottom * fy) * self.scale
+    }
+}
+
+impl Environment {
+    /// Radiance arriving from direction `d` (unit, pointing away from the scene).
+    pub fn radiance(&self, d: Vec3) -> Rgb {
+        match self {
+            Environment::Constant(c) => *c,
+            Environment::Map(m) => m.lookup_uv(direction_to_uv(d)),
+        }
+    }
+
+    /// Sample a direction towards the environment.
+    pub fn sample(&self, u: Vec2) -> Option<LightSample> {
+        let (wi, pdf) = match self {
+            Environment::Constant(_) => (warp::square_to_uniform_sphere(u), warp::UNIFORM_SPHERE_PDF),
+            Environment::Map(m) => {
+                let (uv, pdf_uv) = m.distribution.sample(u);
+                let sin_theta = (uv.y * PI).sin();
+                if sin_theta <= 0.0 || pdf_uv <= 0.0 {
+                    return None;
+                }
+                (uv_to_direction(uv), pdf_uv / (2.0 * PI * PI * sin_theta))
+            }
+        };
+        Some(LightSample { wi, radiance: self.radiance(wi), pdf, point: None })
+    }
+
+    /// Solid-angle density of [`Environment::sample`] returning `d`.
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        match self {
+            Environment::Constant(_) => warp::UNIFORM_SPHERE_PDF,
+            Environment::Map(m) => {
+                let sin_theta = (1.0 - d.y * d.y).max(0.0).sqrt();
+                if sin_theta == 0.0 {
+                    return 0.0;
+                }
+                m.distribution.pdf(direction_to_uv(d)) / (2.0 * PI * PI * sin_theta)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn environment_mapping_matches_mitsuba_orientation() {
+        // Centre column faces +z, u = 0.25 faces +x, row 0 is the zenith.
+        assert!(uv_to_direction(Vec2::new(0.5, 0.5)).distance(Vec3::Z) < 1e-6);
+        assert!(uv_to_direction(Vec2::new(0.25, 0.5)).distance(Vec3::X) < 1e-6);
+        assert!(uv_to_direction(Vec2::new(0.3, 0.0)).distance(Vec3::Y) < 1e-6);
+        for d in [Vec3::new(0.3, 0.4, -0.5), Vec3::new(-0.7, -0.1, 0.2)] {
+            let d = d.normalize();
+            assert!(uv_to_direction(direction_to_uv(d)).distance(d) < 1e-5);
+        }
+    }
+
+    #[test]
+    fn environment_map_pdf_integrates_to_one_and_matches_sampling() {
+        let mut img = Bitmap::new(16, 8, 3);
+        for (i, v) in img.data.iter_mut().enumerate() {
+            *v = ((i * 37) % 11) as f32 + if i % 3 == 0 { 20.0 } else { 0.0 };
+        }
+        let env = Environment::Map(EnvironmentMap::new(img, 1.0));
+        // int pdf dw = 1 over the sphere, by the midpoint rule in (theta, phi) with dw =
+        // sin(theta) dtheta dphi (bounded integrand, unlike in cos(theta) near the poles).
+        let n = 800;
+        let mut total = 0.0f64;
+        for i in 0..n {
+            let theta = PI * (i as f32 + 0.5) / n as f32;
+            for j in 0..2 * n {
+                let phi = PI * (j as f32 + 0.5) / n as f32;
+                let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                total += (env.pdf(d) * theta.sin()) as f64;
+            }
+        }
+        total *= (std::f64::consts::PI / n as f64).powi(2);
+        assert!((total - 1.0).abs() < 2e-3, "{total}");
+        for u in [Vec2::new(0.1, 0.3), Vec2::new(0.77, 0.52), Vec2::new(0.5, 0.99)] {
+            let s = env.sample(u).unwrap();
+            assert!((env.pdf(s.wi) - s.pdf).abs() < 1e-3 * s.pdf, "{} vs {}", env.pdf(s.wi), s.pdf);
+        }
+    }
+}

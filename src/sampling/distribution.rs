@@ -1,0 +1,167 @@
+//! Piecewise-constant distributions for sampling by tabulated weights (pbrt-v4
+//! `PiecewiseConstant1D/2D`): triangles of an emitter by area, texels of an environment map.
+
+use glam::Vec2;
+
+/// A piecewise-constant density over [0, 1] with `n` equal cells, proportional to the given
+/// non-negative weights.
+#[derive(Clone, Debug)]
+pub struct Distribution1D {
+    weights: Vec<f32>,
+    /// cdf[i] = mass of cells < i, normalised; n + 1 entries, cdf[n] = 1.
+    cdf: Vec<f32>,
+    /// Sum of weights / n (the integral of the step function over [0, 1]).
+    integral: f32,
+}
+
+/// A sample of a 1D distribution.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample1D {
+    /// Cell index.
+    pub index: usize,
+    /// Probability of the cell.
+    pub pmf: f32,
+    /// The uniform number rescaled to [0, 1) within the cell (for reuse).
+    pub u_remapped: f32,
+}
+
+impl Distribution1D {
+    /// Build from non-negative finite weights. Negative or non-finite weights count as 0; if
+    /// all are 0, the distribution is uniform.
+    pub fn new(weights: &[f32]) -> Self {
+        assert!(!weights.is_empty(), "Distribution1D needs at least one cell");
+        let mut weights: Vec<f32> = weights.iter().map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 }).collect();
+        let mut total: f64 = weights.iter().map(|&w| w as f64).sum();
+        if total == 0.0 {
+            weights.iter_mut().for_each(|w| *w = 1.0);
+            total = weights.len() as f64;
+        }
+        let mut cdf = Vec::with_capacity(weights.len() + 1);
+        let mut acc = 0.0f64;
+        cdf.push(0.0);
+        for &w in &weights {
+            acc += w as f64;
+            cdf.push((acc / total) as f32);
+        }
+        *cdf.last_mut().expect("non-empty") = 1.0;
+        let integral = (total / weights.len() as f64) as f32;
+        Distribution1D { weights, cdf, integral }
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// Always false: a distribution has at least one cell.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The integral of the (unnormalised) step function over [0, 1].
+    pub fn integral(&self) -> f32 {
+        self.integral
+    }
+
+    /// Probability of cell `i`.
+    #[inline]
+    pub fn pmf(&self, i: usize) -> f32 {
+        self.cdf[i + 1] - self.cdf[i]
+    }
+
+    /// Density at a point of cell `i` (per unit length of [0, 1]).
+    #[inline]
+    pub fn pdf_cell(&self, i: usize) -> f32 {
+        self.weights[i] / self.integral
+    }
+
+    /// Pick a cell with probability proportional to its weight.
+    pub fn sample_discrete(&self, u: f32) -> Sample1D {
+        // Largest i with cdf[i] <= u, skipping empty cells.
+        let i = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(self.len() - 1);
+        let pmf = self.pmf(i);
+        let u_remapped = if pmf > 0.0 { ((u - self.cdf[i]) / pmf).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.0 };
+        Sample1D { index: i, pmf, u_remapped }
+    }
+
+    /// A continuous sample in [0, 1) and its density.
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let s = self.sample_discrete(u);
+        let x = (s.index as f32 + s.u_remapped) / self.len() as f32;
+        (x, self.pdf_cell(s.index), s.index)
+    }
+}
+
+/// A piecewise-constant density over [0, 1]^2 on a `width` x `height` grid: a marginal over
+/// rows and a conditional over the columns of each row.
+#[derive(Clone, Debug)]
+pub struct Distribution2D {
+    rows: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// Build from row-major weights (`height` rows of `width`).
+    pub fn new(weights: &[f32], width: usize, height: usize) -> Self {
+        assert_eq!(weights.len(), width * height);
+        let rows: Vec<Distribution1D> = weights.chunks_exact(width).map(Distribution1D::new).collect();
+        // A row whose weights were all zero became uniform; its marginal weight stays zero.
+        let row_mass: Vec<f32> = weights
+            .chunks_exact(width)
+            .map(|r| r.iter().filter(|w| w.is_finite() && **w > 0.0).sum::<f32>() / width as f32)
+            .collect();
+        Distribution2D { rows, marginal: Distribution1D::new(&row_mass) }
+    }
+
+    /// A point in [0, 1)^2 (x along the row, y across rows) and its density.
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (y, pdf_y, row) = self.marginal.sample_continuous(u.y);
+        let (x, pdf_x, _) = self.rows[row].sample_continuous(u.x);
+        (Vec2::new(x, y), pdf_x * pdf_y)
+    }
+
+    /// Density at a point of [0, 1]^2.
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let h = self.marginal.len();
+        let w = self.rows[0].len();
+        let row = ((p.y * h as f32) as usize).min(h - 1);
+        let col = ((p.x * w as f32) as usize).min(w - 1);
+        self.marginal.pdf_cell(row) * self.rows[row].pdf_cell(col)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distribution1d_frequencies_follow_weights() {
+        let d = Distribution1D::new(&[1.0, 0.0, 3.0, 4.0]);
+        let mut counts = [0usize; 4];
+        let n = 80_000;
+        for i in 0..n {
+            let s = d.sample_discrete((i as f32 + 0.5) / n as f32);
+            counts[s.index] += 1;
+            assert!((0.0..1.0).contains(&s.u_remapped));
+        }
+        assert_eq!(counts[1], 0, "a zero-weight cell is never chosen");
+        for (c, w) in counts.iter().zip([1.0, 0.0, 3.0, 4.0]) {
+            assert!((*c as f32 / n as f32 - w / 8.0).abs() < 1e-3);
+        }
+        assert!((d.pdf_cell(2) - 3.0 / 2.0).abs() < 1e-6, "density = weight / mean weight");
+    }
+
+    #[test]
+    fn distribution2d_pdf_matches_sample_density() {
+        let weights = [1.0, 2.0, 0.0, 5.0, 0.5, 0.5];
+        let d = Distribution2D::new(&weights, 3, 2);
+        let total: f32 = weights.iter().sum();
+        for u in [Vec2::new(0.1, 0.2), Vec2::new(0.9, 0.7), Vec2::new(0.5, 0.99)] {
+            let (p, pdf) = d.sample(u);
+            assert!((d.pdf(p) - pdf).abs() < 1e-5);
+            let cell = (p.y * 2.0) as usize * 3 + (p.x * 3.0) as usize;
+            // Density = weight / (total / cells).
+            assert!((pdf - weights[cell] / (total / 6.0)).abs() < 1e-5);
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! Warps from the unit square to directions and points, with their densities.
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+
+/// Shirley-Chiu concentric map of the unit square to the unit disk (area-preserving).
+#[inline]
+pub fn square_to_uniform_disk_concentric(u: Vec2) -> Vec2 {
+    let p = 2.0 * u - Vec2::ONE;
+    if p.x == 0.0 && p.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) =
+        if p.x.abs() > p.y.abs() { (p.x, FRAC_PI_4 * (p.y / p.x)) } else { (p.y, FRAC_PI_2 - FRAC_PI_4 * (p.x / p.y)) };
+    let (s, c) = theta.sin_cos();
+    Vec2::new(r * c, r * s)
+}
+
+/// Cosine-weighted hemisphere around +z (Malley's method on the concentric disk).
+#[inline]
+pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = square_to_uniform_disk_concentric(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Density of [`square_to_cosine_hemisphere`] (per steradian).
+#[inline]
+pub fn cosine_hemisphere_pdf(w: Vec3) -> f32 {
+    if w.z > 0.0 { w.z * FRAC_1_PI } else { 0.0 }
+}
+
+/// Uniform direction on the unit sphere.
+#[inline]
+pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.y;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.x).sin_cos();
+    Vec3::new(r * c, r * s, z)
+}
+
+/// Density of [`square_to_uniform_sphere`].
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Uniform point on a triangle, as barycentric weights (b1, b2) of its second and third
+/// vertices (the square-root parameterisation).
+#[inline]
+pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
+    let t = (1.0 - u.x).max(0.0).sqrt();
+    Vec2::new(1.0 - t, t * u.y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn concentric_disk_stays_in_disk_and_preserves_area() {
+        // Equal-area: the fraction of a uniform grid landing within radius r is r^2.
+        let n = 200;
+        let mut inside_half = 0;
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let d = square_to_uniform_disk_concentric(u);
+                assert!(d.length() <= 1.0 + 1e-6);
+                if d.length() < 0.5 {
+                    inside_half += 1;
+                }
+            }
+        }
+        let frac = inside_half as f32 / (n * n) as f32;
+        assert!((frac - 0.25).abs() < 0.01, "{frac}");
+    }
+
+    #[test]
+    fn cosine_hemisphere_mean_cosine_is_two_thirds() {
+        // E[cos] under p = cos/pi is (1/pi) * int cos^2 dw = 2/3.
+        let n = 300;
+        let mut sum = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let w = square_to_cosine_hemisphere(u);
+                assert!((w.length() - 1.0).abs() < 1e-5 && w.z >= 0.0);
+                sum += w.z;
+            }
+        }
+        let mean = sum / (n * n) as f32;
+        assert!((mean - 2.0 / 3.0).abs() < 1e-3, "{mean}");
+    }
+
+    #[test]
+    fn uniform_triangle_barycentrics_are_uniform() {
+        // The mean of uniform barycentrics is (1/3, 1/3).
+        let n = 300;
+        let mut sum = Vec2::ZERO;
+        for i in 0..n {
+            for j in 0..n {
+                let b = square_to_uniform_triangle(Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32));
+                assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+                sum += b;
+            }
+        }
+        let mean = sum / (n * n) as f32;
+        assert!(mean.distance(Vec2::splat(1.0 / 3.0)) < 2e-3, "{mean}");
+    }
+}

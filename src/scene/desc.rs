@@ -1,0 +1,519 @@
+//! The scene file format (TOML), as serde types. `docs/scene-format.md` is the user's
+//! reference; every struct rejects unknown fields so that a typo is an error, not a default.
+
+use crate::camera::FovAxis;
+use crate::image::ColorSpace;
+use crate::texture::{Channel, Filter};
+use serde::Deserialize;
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// A whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// Image and integrator settings.
+    #[serde(default)]
+    pub render: RenderDesc,
+    /// The camera.
+    pub camera: CameraDesc,
+    /// Light from infinitely far away.
+    pub environment: Option<EnvironmentDesc>,
+    /// Named textures.
+    #[serde(default)]
+    pub textures: BTreeMap<String, TextureDesc>,
+    /// Named materials.
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    /// Geometry.
+    #[serde(default)]
+    pub shapes: Vec<ShapeDesc>,
+}
+
+/// `[render]`: image size, sampling and path length.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderDesc {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Longest path in segments, as Mitsuba counts (1: emitters only, 2: direct light); -1 for
+    /// no limit (Russian roulette ends paths).
+    pub max_depth: i64,
+    /// Path depth from which Russian roulette applies.
+    pub rr_depth: u32,
+    /// Seed of the sampler.
+    pub seed: u64,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        RenderDesc { width: 512, height: 512, spp: 16, max_depth: -1, rr_depth: 5, seed: 0 }
+    }
+}
+
+/// `[camera]`: a perspective camera, placed by eye/target/up, a matrix, or a glTF file's camera.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Field of view in degrees along `fov_axis`.
+    pub fov: Option<f32>,
+    /// Which axis `fov` spans (default y).
+    pub fov_axis: Option<FovAxis>,
+    /// Camera position.
+    pub eye: Option<[f32; 3]>,
+    /// Point the camera looks at.
+    pub target: Option<[f32; 3]>,
+    /// Up direction (default +y).
+    pub up: Option<[f32; 3]>,
+    /// Camera-to-world matrix, row-major (camera looks down its local -z).
+    pub matrix: Option<[f32; 16]>,
+    /// Take the camera from this glTF file.
+    pub gltf: Option<String>,
+    /// Which of the glTF file's camera nodes (default the first).
+    pub index: Option<usize>,
+}
+
+/// `[environment]`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum EnvironmentDesc {
+    /// The same radiance from every direction.
+    Constant {
+        /// Radiance (a number or [r, g, b]).
+        radiance: RgbValue,
+    },
+    /// An equirectangular map (EXR or HDR).
+    Envmap {
+        /// Image file.
+        filename: String,
+        /// Radiance multiplier (default 1).
+        #[serde(default = "one")]
+        scale: f32,
+    },
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+fn unit_scale() -> [f32; 2] {
+    [1.0, 1.0]
+}
+
+/// `[textures.NAME]`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TextureDesc {
+    /// An image file (PNG, JPEG, HDR, EXR).
+    Image {
+        /// Image file.
+        filename: String,
+        /// Lookup filter (default `none`: bilinear at the point).
+        #[serde(default)]
+        filter: Filter,
+        /// How integer values encode colour; by default sRGB where the texture feeds a colour
+        /// and linear where it feeds a scalar or a normal map.
+        colorspace: Option<ColorSpace>,
+        /// Multiplier of the texture coordinates (default [1, 1]).
+        #[serde(default = "unit_scale")]
+        scale: [f32; 2],
+        /// Offset added to the scaled texture coordinates (default [0, 0]).
+        #[serde(default)]
+        offset: [f32; 2],
+    },
+}
+
+/// `[materials.NAME]`. Parameter names and defaults follow Mitsuba 3's plugins.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialDesc {
+    /// Lambertian (`diffuse`).
+    Diffuse {
+        /// Albedo (default 0.5).
+        reflectance: Option<ColorValue>,
+        /// Scatter from the back side as from the front.
+        #[serde(default)]
+        two_sided: bool,
+        /// Tangent-space normal map texture.
+        normal_map: Option<String>,
+    },
+    /// Metal (`conductor` when no roughness is given, else `roughconductor`).
+    Conductor {
+        /// Isotropic GGX roughness.
+        alpha: Option<FloatValue>,
+        /// GGX roughness along the tangent (dp/du).
+        alpha_u: Option<FloatValue>,
+        /// GGX roughness along the bitangent.
+        alpha_v: Option<FloatValue>,
+        /// Named conductor (`Al`, or `none` for a perfect mirror); default `none` unless eta/k.
+        material: Option<String>,
+        /// Real part of the IOR.
+        eta: Option<RgbValue>,
+        /// Imaginary part of the IOR.
+        k: Option<RgbValue>,
+        /// Factor on the reflectance (default 1).
+        specular_reflectance: Option<ColorValue>,
+        /// Scatter from the back side as from the front.
+        #[serde(default)]
+        two_sided: bool,
+        /// Tangent-space normal map texture.
+        normal_map: Option<String>,
+    },
+    /// Glass (`dielectric`, or `roughdielectric` with a roughness).
+    Dielectric {
+        /// Isotropic GGX roughness.
+        alpha: Option<FloatValue>,
+        /// GGX roughness along the tangent.
+        alpha_u: Option<FloatValue>,
+        /// GGX roughness along the bitangent.
+        alpha_v: Option<FloatValue>,
+        /// Interior IOR (number or name; default `bk7`).
+        int_ior: Option<IorValue>,
+        /// Exterior IOR (default `air`).
+        ext_ior: Option<IorValue>,
+        /// Factor on reflection (default 1).
+        specular_reflectance: Option<ColorValue>,
+        /// Factor on transmission (default 1).
+        specular_transmittance: Option<ColorValue>,
+        /// Tangent-space normal map texture.
+        normal_map: Option<String>,
+    },
+    /// Rough plastic (`roughplastic`).
+    Plastic {
+        /// Albedo of the base (default 0.5).
+        diffuse_reflectance: Option<ColorValue>,
+        /// Factor on the coating (default 1).
+        specular_reflectance: Option<ColorValue>,
+        /// GGX roughness of the coating (default 0.1).
+        alpha: Option<f32>,
+        /// Interior IOR (default `polypropylene`).
+        int_ior: Option<IorValue>,
+        /// Exterior IOR (default `air`).
+        ext_ior: Option<IorValue>,
+        /// Scatter from the back side as from the front.
+        #[serde(default)]
+        two_sided: bool,
+        /// Tangent-space normal map texture.
+        normal_map: Option<String>,
+    },
+    /// glTF 2.0 metallic-roughness.
+    Pbr {
+        /// Base colour (default 1).
+        base_color: Option<ColorValue>,
+        /// Metalness (default 1, as glTF).
+        metallic: Option<FloatValue>,
+        /// glTF roughness (default 1); alpha = roughness^2.
+        roughness: Option<FloatValue>,
+        /// Scatter from the back side as from the front.
+        #[serde(default)]
+        two_sided: bool,
+        /// Tangent-space normal map texture.
+        normal_map: Option<String>,
+    },
+}
+
+/// `[[shapes]]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeDesc {
+    /// `obj`, `gltf`, `rectangle`, `cube` or `uv_sphere`.
+    #[serde(rename = "type")]
+    pub kind: ShapeKind,
+    /// Mesh file (obj, gltf).
+    pub filename: Option<String>,
+    /// Segments around the axis (uv_sphere, default 64).
+    pub segments: Option<u32>,
+    /// Rings from pole to pole (uv_sphere, default 32).
+    pub rings: Option<u32>,
+    /// Material name (default: diffuse 0.5; glTF files bring their own).
+    pub material: Option<String>,
+    /// Radiance emitted from the front side: makes the shape an area light.
+    pub emission: Option<RgbValue>,
+    /// Transform steps, applied in order.
+    #[serde(default)]
+    pub transform: Vec<TransformStep>,
+}
+
+/// Kinds of shapes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    /// Wavefront OBJ file.
+    Obj,
+    /// glTF 2.0 file (.gltf or .glb): meshes, node transforms and materials.
+    Gltf,
+    /// [-1, 1]^2 in z = 0, facing +z.
+    Rectangle,
+    /// [-1, 1]^3.
+    Cube,
+    /// The UV sphere of the Mitsuba test scenes.
+    UvSphere,
+}
+
+/// One step of a transform; exactly one of the operations.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformStep {
+    /// Translation.
+    pub translate: Option<[f32; 3]>,
+    /// Uniform (number) or per-axis ([x, y, z]) scale.
+    pub scale: Option<RgbValue>,
+    /// Rotation axis (with `angle`).
+    pub rotate: Option<[f32; 3]>,
+    /// Rotation angle in degrees, counter-clockwise about `rotate` (right-hand rule).
+    pub angle: Option<f32>,
+    /// Mitsuba's `lookat`: local +z turned towards `target`.
+    pub lookat: Option<LookAt>,
+    /// A 4x4 matrix, row-major.
+    pub matrix: Option<[f32; 16]>,
+}
+
+/// Mitsuba's `lookat` transform.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LookAt {
+    /// New origin.
+    pub origin: [f32; 3],
+    /// Point local +z turns towards.
+    pub target: [f32; 3],
+    /// Up direction (default +y).
+    pub up: Option<[f32; 3]>,
+}
+
+/// A colour, written as a number (grey) or [r, g, b].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RgbValue(pub [f32; 3]);
+
+/// A colour parameter: a number, [r, g, b], a texture name, or `{ texture = NAME, scale = .. }`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColorValue {
+    /// A constant.
+    Value([f32; 3]),
+    /// A texture, optionally scaled.
+    Texture {
+        /// Texture name.
+        name: String,
+        /// Factor on the texture's value.
+        scale: [f32; 3],
+    },
+}
+
+/// A scalar parameter: a number, a texture name, or `{ texture = NAME, channel = .., scale = .. }`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FloatValue {
+    /// A constant.
+    Value(f32),
+    /// A texture's channel, optionally scaled.
+    Texture {
+        /// Texture name.
+        name: String,
+        /// Channel read (default the mean of RGB).
+        channel: Channel,
+        /// Factor on the value.
+        scale: f32,
+    },
+}
+
+/// An index of refraction: a number or a name (`bk7`, `air`, `water`, ...).
+#[derive(Clone, Debug, PartialEq)]
+pub enum IorValue {
+    /// A number.
+    Value(f32),
+    /// A named material.
+    Named(String),
+}
+
+fn finite(v: f64) -> Result<f32, String> {
+    let f = v as f32;
+    if f.is_finite() { Ok(f) } else { Err(format!("{v} is not a finite number")) }
+}
+
+fn read_triple<'de, A: SeqAccess<'de>>(mut seq: A) -> Result<[f32; 3], A::Error> {
+    let mut out = [0.0f32; 3];
+    for (i, slot) in out.iter_mut().enumerate() {
+        let v: f64 = seq.next_element()?.ok_or_else(|| de::Error::invalid_length(i, &"three numbers"))?;
+        *slot = finite(v).map_err(de::Error::custom)?;
+    }
+    if seq.next_element::<f64>()?.is_some() {
+        return Err(de::Error::invalid_length(4, &"three numbers"));
+    }
+    Ok(out)
+}
+
+/// Keys of an inline texture reference.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TextureRef {
+    texture: String,
+    channel: Option<Channel>,
+    scale: Option<RgbValue>,
+}
+
+impl<'de> Deserialize<'de> for RgbValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RgbValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number or [r, g, b]")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<RgbValue, E> {
+                finite(v).map(|f| RgbValue([f; 3])).map_err(E::custom)
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<RgbValue, E> {
+                self.visit_f64(v as f64)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<RgbValue, A::Error> {
+                read_triple(seq).map(RgbValue)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for ColorValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = ColorValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number, [r, g, b], a texture name or { texture = NAME, scale = .. }")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<ColorValue, E> {
+                finite(v).map(|f| ColorValue::Value([f; 3])).map_err(E::custom)
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<ColorValue, E> {
+                self.visit_f64(v as f64)
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<ColorValue, E> {
+                Ok(ColorValue::Texture { name: v.to_string(), scale: [1.0; 3] })
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<ColorValue, A::Error> {
+                read_triple(seq).map(ColorValue::Value)
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ColorValue, A::Error> {
+                let r = TextureRef::deserialize(de::value::MapAccessDeserializer::new(map))?;
+                if r.channel.is_some() {
+                    return Err(de::Error::custom("`channel` applies to scalar parameters, not colours"));
+                }
+                Ok(ColorValue::Texture { name: r.texture, scale: r.scale.map_or([1.0; 3], |s| s.0) })
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for FloatValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = FloatValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number, a texture name or { texture = NAME, channel = .., scale = .. }")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<FloatValue, E> {
+                finite(v).map(FloatValue::Value).map_err(E::custom)
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<FloatValue, E> {
+                self.visit_f64(v as f64)
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<FloatValue, E> {
+                Ok(FloatValue::Texture { name: v.to_string(), channel: Channel::Mean, scale: 1.0 })
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<FloatValue, A::Error> {
+                let r = TextureRef::deserialize(de::value::MapAccessDeserializer::new(map))?;
+                let scale = match r.scale {
+                    None => 1.0,
+                    Some(RgbValue([a, b, c])) if a == b && b == c => a,
+                    Some(_) => {
+                        return Err(de::Error::custom("the scale of a scalar parameter is one number"));
+                    }
+                };
+                Ok(FloatValue::Texture { name: r.texture, channel: r.channel.unwrap_or_default(), scale })
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+impl<'de> Deserialize<'de> for IorValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = IorValue;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an index of refraction: a number or a name such as \"bk7\"")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<IorValue, E> {
+                finite(v).map(IorValue::Value).map_err(E::custom)
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<IorValue, E> {
+                self.visit_f64(v as f64)
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<IorValue, E> {
+                Ok(IorValue::Named(v.to_string()))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_desc_parses_parameter_forms() {
+        let src = r#"
+            [camera]
+            fov = 40
+            eye = [0, 1, 2]
+            target = [0, 0, 0]
+            [materials.a]
+            type = "diffuse"
+            reflectance = [0.1, 0.2, 0.3]
+            [materials.b]
+            type = "conductor"
+            alpha_u = "rough"
+            alpha_v = { texture = "rough", channel = "g", scale = 0.5 }
+            material = "Al"
+            [materials.c]
+            type = "diffuse"
+            reflectance = { texture = "tex", scale = [1, 0.5, 0.25] }
+        "#;
+        let d: SceneDesc = toml::from_str(src).unwrap();
+        assert!(matches!(
+            &d.materials["a"],
+            MaterialDesc::Diffuse { reflectance: Some(ColorValue::Value([0.1, 0.2, 0.3])), .. }
+        ));
+        let MaterialDesc::Conductor { alpha_u, alpha_v, .. } = &d.materials["b"] else { panic!() };
+        assert_eq!(
+            alpha_u.as_ref().unwrap(),
+            &FloatValue::Texture { name: "rough".into(), channel: Channel::Mean, scale: 1.0 }
+        );
+        assert_eq!(
+            alpha_v.as_ref().unwrap(),
+            &FloatValue::Texture { name: "rough".into(), channel: Channel::G, scale: 0.5 }
+        );
+        assert_eq!(d.render.spp, 16);
+    }
+
+    #[test]
+    fn scene_desc_rejects_typos_and_bad_values() {
+        for (src, needle) in [
+            ("[camera]\nfov = 40\nfvo = 3\n", "unknown field `fvo`"),
+            ("[camera]\n[materials.a]\ntype = \"difuse\"\n", "unknown variant `difuse`"),
+            ("[camera]\n[materials.a]\ntype = \"diffuse\"\nreflectance = [1, 2]\n", "three numbers"),
+            ("[camera]\n[materials.a]\ntype = \"diffuse\"\nreflectance = nan\n", "not a finite number"),
+            ("[camera]\n[render]\nspp = -3\n", "u32"),
+        ] {
+            let err = toml::from_str::<SceneDesc>(src).unwrap_err().to_string();
+            assert!(err.contains(needle), "{src:?}: {err}");
+        }
+    }
+}

@@ -1,0 +1,582 @@
+//! Scene loading: the TOML description to a renderable [`Scene`]. Paths are relative to the
+//! scene file; every error names the scene file and the item, and the file at fault.
+
+use super::desc::{
+    CameraDesc, ColorValue, EnvironmentDesc, FloatValue, IorValue, MaterialDesc, RenderDesc, RgbValue, SceneDesc,
+    ShapeDesc, ShapeKind, TextureDesc, TransformStep,
+};
+use super::{Geometry, RenderSettings, Scene};
+use crate::accel::Accel;
+use crate::bsdf::PlasticTables;
+use crate::camera::{FovAxis, PerspectiveCamera};
+use crate::color::Rgb;
+use crate::error::{Error, Result};
+use crate::geometry::{TriangleMesh, obj, shapes};
+use crate::image::{ColorSpace, read_bitmap};
+use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
+use crate::material::{
+    ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
+};
+use crate::texture::{ImageTexture, MipMap, Texture};
+use glam::{Mat4, Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+/// Largest image side accepted.
+const MAX_RESOLUTION: u32 = 32_768;
+/// Largest pixel count accepted (a 16k x 16k image).
+const MAX_PIXELS: u64 = 1 << 28;
+/// Largest sample count per pixel accepted.
+const MAX_SPP: u32 = 1 << 24;
+
+/// Settings given on the command line that replace the scene file's.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SceneOverrides {
+    /// Samples per pixel.
+    pub spp: Option<u32>,
+    /// Sampler seed.
+    pub seed: Option<u64>,
+    /// Image width.
+    pub width: Option<u32>,
+    /// Image height.
+    pub height: Option<u32>,
+    /// Path length (-1 unlimited).
+    pub max_depth: Option<i64>,
+}
+
+/// Load a scene file.
+pub fn load_scene(path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    load_scene_str(&text, path, overrides)
+}
+
+/// Load a scene from its text; `path` names it in messages and anchors its relative paths.
+pub fn load_scene_str(text: &str, path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
+    let desc: SceneDesc = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        Error::Scene { path: path.to_path_buf(), line, msg: e.message().to_string() }
+    })?;
+    Loader::new(path, &desc).load(&desc, overrides)
+}
+
+/// The IOR-1.5 tables shared by every `pbr` material (computed once per process).
+fn pbr_tables() -> Arc<PlasticTables> {
+    static TABLES: OnceLock<Arc<PlasticTables>> = OnceLock::new();
+    TABLES.get_or_init(|| Arc::new(PlasticTables::new(1.5, &PlasticTables::alpha_grid()))).clone()
+}
+
+/// How a texture is used, which decides its default colour space.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Role {
+    Color,
+    Data,
+}
+
+struct Loader<'a> {
+    path: &'a Path,
+    base: PathBuf,
+    texture_descs: &'a std::collections::BTreeMap<String, TextureDesc>,
+    textures: Vec<Texture>,
+    loaded_textures: HashMap<(String, ColorSpace), TextureId>,
+    plastic_tables: HashMap<(u32, u32), Arc<PlasticTables>>,
+    warnings: Vec<String>,
+}
+
+impl<'a> Loader<'a> {
+    fn new(path: &'a Path, desc: &'a SceneDesc) -> Self {
+        let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Loader {
+            path,
+            base,
+            texture_descs: &desc.textures,
+            textures: Vec::new(),
+            loaded_textures: HashMap::new(),
+            plastic_tables: HashMap::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    fn error(&self, msg: impl Into<String>) -> Error {
+        Error::scene(self.path, msg)
+    }
+
+    fn resolve_path(&self, file: &str) -> PathBuf {
+        self.base.join(file)
+    }
+
+    fn load(mut self, desc: &SceneDesc, overrides: &SceneOverrides) -> Result<Scene> {
+        let settings = self.settings(&desc.render, overrides)?;
+
+        let mut materials = Vec::new();
+        let mut material_ids = HashMap::new();
+        for (name, m) in &desc.materials {
+            let material = self.material(m, &format!("materials.{name}"))?;
+            material_ids.insert(name.clone(), materials.len() as u32);
+            materials.push(material);
+        }
+        let mut default_material = None;
+
+        let mut geometry = Geometry::default();
+        let mut lights = Lights::default();
+        for (i, shape) in desc.shapes.iter().enumerate() {
+            let item = match &shape.filename {
+                Some(f) => format!("shapes[{i}] ({f})"),
+                None => format!("shapes[{i}]"),
+            };
+            let assigned = match &shape.material {
+                Some(name) => Some(*material_ids.get(name).ok_or_else(|| {
+                    self.error(format!(
+                        "{item}: unknown material '{name}' (defined: {})",
+                        desc.materials.keys().cloned().collect::<Vec<_>>().join(", ")
+                    ))
+                })?),
+                None => None,
+            };
+            let transform = self.transform(&shape.transform, &item)?;
+            let emission = match shape.emission {
+                Some(RgbValue(e)) if e.iter().any(|v| *v < 0.0) => {
+                    return Err(self.error(format!("{item}.emission: negative radiance {e:?}")));
+                }
+                Some(RgbValue(e)) if e.iter().any(|v| *v > 0.0) => Some(Rgb::from(e)),
+                _ => None,
+            };
+            for (mesh, material) in self.shape_meshes(shape, &item, &mut materials)? {
+                let mut mesh = mesh;
+                mesh.transform(&transform);
+                let cleanup = mesh.validate().map_err(|msg| self.error(format!("{item}: {msg}")))?;
+                if cleanup.degenerate_triangles > 0 {
+                    self.warnings.push(format!(
+                        "{}: {item}: dropped {} zero-area triangles",
+                        self.path.display(),
+                        cleanup.degenerate_triangles
+                    ));
+                }
+                let material = match assigned.or(material) {
+                    Some(m) => m,
+                    None => *default_material.get_or_insert_with(|| {
+                        materials.push(Material::default_diffuse());
+                        materials.len() as u32 - 1
+                    }),
+                };
+                let light = emission.map(|radiance| {
+                    let tris = (0..mesh.triangle_count()).map(|t| mesh.triangle(t)).collect();
+                    lights.area.push(AreaLight::new(tris, radiance));
+                    lights.area.len() as u32 - 1
+                });
+                geometry.add(mesh, item.clone(), material, light);
+            }
+        }
+
+        lights.environment = match &desc.environment {
+            Some(env) => Some(self.environment(env)?),
+            None => None,
+        };
+        let camera = self.camera(&desc.camera, &settings)?;
+        let triangles: Vec<[Vec3; 3]> = (0..geometry.triangles.len()).map(|t| geometry.triangle_positions(t)).collect();
+        let accel = Accel::build(&triangles);
+        Ok(Scene {
+            path: self.path.to_path_buf(),
+            settings,
+            camera,
+            geometry,
+            accel,
+            materials,
+            textures: self.textures,
+            lights,
+            warnings: self.warnings,
+        })
+    }
+
+    fn settings(&self, r: &RenderDesc, o: &SceneOverrides) -> Result<RenderSettings> {
+        let width = o.width.unwrap_or(r.width);
+        let height = o.height.unwrap_or(r.height);
+        let spp = o.spp.unwrap_or(r.spp);
+        let max_depth = o.max_depth.unwrap_or(r.max_depth);
+        if width == 0
+            || height == 0
+            || width > MAX_RESOLUTION
+            || height > MAX_RESOLUTION
+            || width as u64 * height as u64 > MAX_PIXELS
+        {
+            return Err(Error::param(
+                "render.width/height",
+                format!("{width}x{height} is outside 1..{MAX_RESOLUTION} per side and {MAX_PIXELS} pixels"),
+            )
+            .in_scene(self.path, "render"));
+        }
+        if spp == 0 || spp > MAX_SPP {
+            return Err(
+                Error::param("render.spp", format!("{spp} is outside 1..={MAX_SPP}")).in_scene(self.path, "render")
+            );
+        }
+        let max_depth = match max_depth {
+            -1 => None,
+            d if (1..=i64::from(u32::MAX)).contains(&d) => Some(d as u32),
+            d => {
+                return Err(Error::param("render.max_depth", format!("{d}: use -1 (unlimited) or at least 1"))
+                    .in_scene(self.path, "render"));
+            }
+        };
+        Ok(RenderSettings { width, height, spp, max_depth, rr_depth: r.rr_depth, seed: o.seed.unwrap_or(r.seed) })
+    }
+
+    fn texture(&mut self, name: &str, role: Role, item: &str) -> Result<TextureId> {
+        let Some(TextureDesc::Image { filename, filter, colorspace, scale, offset }) = self.texture_descs.get(name)
+        else {
+            return Err(self.error(format!(
+                "{item}: unknown texture '{name}' (defined: {})",
+                self.texture_descs.keys().cloned().collect::<Vec<_>>().join(", ")
+            )));
+        };
+        let space = colorspace.unwrap_or(if role == Role::Color { ColorSpace::Srgb } else { ColorSpace::Linear });
+        if let Some(id) = self.loaded_textures.get(&(name.to_string(), space)) {
+            return Ok(*id);
+        }
+        let file = self.resolve_path(filename);
+        let bitmap = read_bitmap(&file, space).map_err(|e| e.in_scene(self.path, format!("textures.{name}")))?;
+        if !(scale.iter().chain(offset).all(|v| v.is_finite())) {
+            return Err(self.error(format!("textures.{name}: scale and offset must be finite")));
+        }
+        let texture = Texture::Image(ImageTexture {
+            mipmap: MipMap::new(bitmap),
+            filter: *filter,
+            scale: Vec2::from(*scale),
+            offset: Vec2::from(*offset),
+        });
+        let id = self.add_texture(texture);
+        self.loaded_textures.insert((name.to_string(), space), id);
+        Ok(id)
+    }
+
+    fn add_texture(&mut self, texture: Texture) -> TextureId {
+        self.textures.push(texture);
+        TextureId(self.textures.len() as u32 - 1)
+    }
+
+    fn color(&mut self, v: Option<&ColorValue>, default: f32, item: &str) -> Result<ColorParam> {
+        Ok(match v {
+            None => ColorParam::Value(Rgb::splat(default)),
+            Some(ColorValue::Value(c)) => ColorParam::Value(Rgb::from(*c)),
+            Some(ColorValue::Texture { name, scale }) => {
+                ColorParam::Texture { id: self.texture(name, Role::Color, item)?, scale: Rgb::from(*scale) }
+            }
+        })
+    }
+
+    fn float(&mut self, v: &FloatValue, item: &str, valid: impl Fn(f32) -> bool, expected: &str) -> Result<FloatParam> {
+        Ok(match v {
+            FloatValue::Value(x) if !valid(*x) => {
+                return Err(self.error(format!("{item}: {x} is not {expected}")));
+            }
+            FloatValue::Value(x) => FloatParam::Value(*x),
+            FloatValue::Texture { name, channel, scale } => {
+                FloatParam::Texture { id: self.texture(name, Role::Data, item)?, channel: *channel, scale: *scale }
+            }
+        })
+    }
+
+    fn roughness(
+        &mut self,
+        alpha: &Option<FloatValue>,
+        alpha_u: &Option<FloatValue>,
+        alpha_v: &Option<FloatValue>,
+        item: &str,
+    ) -> Result<Option<Roughness>> {
+        let valid = |a: f32| (0.0..=10.0).contains(&a);
+        let expected = "a roughness in [0, 10]";
+        let (u, v) = match (alpha, alpha_u, alpha_v) {
+            (None, None, None) => return Ok(None),
+            (Some(a), None, None) => (a, a),
+            (None, Some(u), Some(v)) => (u, v),
+            (Some(_), _, _) => {
+                return Err(self.error(format!("{item}: give either alpha or alpha_u and alpha_v")));
+            }
+            _ => return Err(self.error(format!("{item}: alpha_u and alpha_v must both be given"))),
+        };
+        Ok(Some(Roughness {
+            alpha_u: self.float(u, &format!("{item}.alpha_u"), valid, expected)?,
+            alpha_v: self.float(v, &format!("{item}.alpha_v"), valid, expected)?,
+        }))
+    }
+
+    fn ior(&self, v: &Option<IorValue>, default: &str, item: &str) -> Result<f32> {
+        let ior = match v {
+            None => named_ior(default).expect("default IOR names are in the table"),
+            Some(IorValue::Value(x)) => *x,
+            Some(IorValue::Named(name)) => {
+                named_ior(name).ok_or_else(|| self.error(format!("{item}: unknown IOR name '{name}'")))?
+            }
+        };
+        if !(ior > 0.0 && ior < 100.0) {
+            return Err(self.error(format!("{item}: {ior} is not an index of refraction")));
+        }
+        Ok(ior)
+    }
+
+    fn relative_ior(
+        &self,
+        int: &Option<IorValue>,
+        ext: &Option<IorValue>,
+        int_default: &str,
+        item: &str,
+    ) -> Result<f32> {
+        let int = self.ior(int, int_default, &format!("{item}.int_ior"))?;
+        let ext = self.ior(ext, "air", &format!("{item}.ext_ior"))?;
+        if int == ext {
+            return Err(self.error(format!("{item}: int_ior and ext_ior must differ")));
+        }
+        Ok(int / ext)
+    }
+
+    fn normal_map(&mut self, name: &Option<String>, item: &str) -> Result<Option<TextureId>> {
+        name.as_ref().map(|n| self.texture(n, Role::Data, &format!("{item}.normal_map"))).transpose()
+    }
+
+    fn material(&mut self, m: &MaterialDesc, item: &str) -> Result<Material> {
+        let (kind, normal_map, two_sided) = match m {
+            MaterialDesc::Diffuse { reflectance, two_sided, normal_map } => (
+                MaterialKind::Diffuse {
+                    reflectance: self.color(reflectance.as_ref(), 0.5, &format!("{item}.reflectance"))?,
+                },
+                normal_map,
+                *two_sided,
+            ),
+            MaterialDesc::Conductor {
+                alpha,
+                alpha_u,
+                alpha_v,
+                material,
+                eta,
+                k,
+                specular_reflectance,
+                two_sided,
+                normal_map,
+            } => {
+                let (eta, k) = match (material, eta, k) {
+                    (Some(name), None, None) => named_conductor(name).ok_or_else(|| {
+                        self.error(format!(
+                            "{item}.material: unknown conductor '{name}' (known: Al, none; or give eta and k)"
+                        ))
+                    })?,
+                    (None, Some(RgbValue(e)), Some(RgbValue(k))) => (Rgb::from(*e), Rgb::from(*k)),
+                    (None, None, None) => named_conductor("none").expect("in the table"),
+                    _ => return Err(self.error(format!("{item}: give either material or both eta and k"))),
+                };
+                let roughness = self.roughness(alpha, alpha_u, alpha_v, item)?;
+                let specular_reflectance =
+                    self.color(specular_reflectance.as_ref(), 1.0, &format!("{item}.specular_reflectance"))?;
+                (MaterialKind::Conductor { roughness, eta, k, specular_reflectance }, normal_map, *two_sided)
+            }
+            MaterialDesc::Dielectric {
+                alpha,
+                alpha_u,
+                alpha_v,
+                int_ior,
+                ext_ior,
+                specular_reflectance,
+                specular_transmittance,
+                normal_map,
+            } => {
+                let eta = self.relative_ior(int_ior, ext_ior, "bk7", item)?;
+                let roughness = self.roughness(alpha, alpha_u, alpha_v, item)?;
+                let specular_reflectance =
+                    self.color(specular_reflectance.as_ref(), 1.0, &format!("{item}.specular_reflectance"))?;
+                let specular_transmittance =
+                    self.color(specular_transmittance.as_ref(), 1.0, &format!("{item}.specular_transmittance"))?;
+                (
+                    MaterialKind::Dielectric { roughness, eta, specular_reflectance, specular_transmittance },
+                    normal_map,
+                    false,
+                )
+            }
+            MaterialDesc::Plastic {
+                diffuse_reflectance,
+                specular_reflectance,
+                alpha,
+                int_ior,
+                ext_ior,
+                two_sided,
+                normal_map,
+            } => {
+                let eta = self.relative_ior(int_ior, ext_ior, "polypropylene", item)?;
+                let alpha = alpha.unwrap_or(0.1);
+                if !(alpha > 0.0 && alpha <= 10.0) {
+                    return Err(self.error(format!("{item}.alpha: {alpha} is not in (0, 10]")));
+                }
+                let tables = self
+                    .plastic_tables
+                    .entry((eta.to_bits(), alpha.to_bits()))
+                    .or_insert_with(|| Arc::new(PlasticTables::new(eta, &[alpha])))
+                    .clone();
+                let diffuse_reflectance =
+                    self.color(diffuse_reflectance.as_ref(), 0.5, &format!("{item}.diffuse_reflectance"))?;
+                let specular_reflectance =
+                    self.color(specular_reflectance.as_ref(), 1.0, &format!("{item}.specular_reflectance"))?;
+                (
+                    MaterialKind::Plastic { diffuse_reflectance, specular_reflectance, alpha, tables },
+                    normal_map,
+                    *two_sided,
+                )
+            }
+            MaterialDesc::Pbr { base_color, metallic, roughness, two_sided, normal_map } => {
+                let unit = |x: f32| (0.0..=1.0).contains(&x);
+                let base_color = self.color(base_color.as_ref(), 1.0, &format!("{item}.base_color"))?;
+                let metallic = self.float(
+                    metallic.as_ref().unwrap_or(&FloatValue::Value(1.0)),
+                    &format!("{item}.metallic"),
+                    unit,
+                    "in [0, 1]",
+                )?;
+                let roughness = self.float(
+                    roughness.as_ref().unwrap_or(&FloatValue::Value(1.0)),
+                    &format!("{item}.roughness"),
+                    unit,
+                    "in [0, 1]",
+                )?;
+                (MaterialKind::Pbr { base_color, metallic, roughness, tables: pbr_tables() }, normal_map, *two_sided)
+            }
+        };
+        let normal_map = self.normal_map(normal_map, item)?;
+        Ok(Material { kind, normal_map, two_sided })
+    }
+
+    fn transform(&self, steps: &[TransformStep], item: &str) -> Result<Mat4> {
+        let mut m = Mat4::IDENTITY;
+        for (i, s) in steps.iter().enumerate() {
+            let here = format!("{item}.transform[{i}]");
+            let given =
+                [s.translate.is_some(), s.scale.is_some(), s.rotate.is_some(), s.lookat.is_some(), s.matrix.is_some()];
+            if given.iter().filter(|g| **g).count() != 1 || (s.angle.is_some() != s.rotate.is_some()) {
+                return Err(self.error(format!(
+                    "{here}: give exactly one of translate, scale, rotate (with angle), lookat or matrix"
+                )));
+            }
+            let step = if let Some(t) = s.translate {
+                Mat4::from_translation(Vec3::from(t))
+            } else if let Some(RgbValue(sc)) = s.scale {
+                Mat4::from_scale(Vec3::from(sc))
+            } else if let (Some(axis), Some(angle)) = (s.rotate, s.angle) {
+                let axis = Vec3::from(axis)
+                    .try_normalize()
+                    .ok_or_else(|| self.error(format!("{here}: zero rotation axis")))?;
+                Mat4::from_axis_angle(axis, angle.to_radians())
+            } else if let Some(l) = &s.lookat {
+                mitsuba_look_at(Vec3::from(l.origin), Vec3::from(l.target), Vec3::from(l.up.unwrap_or([0.0, 1.0, 0.0])))
+                    .ok_or_else(|| self.error(format!("{here}: origin, target and up do not define a frame")))?
+            } else {
+                Mat4::from_cols_array(&s.matrix.expect("checked above")).transpose()
+            };
+            m = step * m;
+        }
+        if !m.is_finite() || m.determinant().abs() < 1e-20 {
+            return Err(self.error(format!("{item}.transform: the transform is singular or not finite")));
+        }
+        Ok(m)
+    }
+
+    /// The meshes of a shape, each with the material it brings (glTF) if any.
+    fn shape_meshes(
+        &mut self,
+        shape: &ShapeDesc,
+        item: &str,
+        materials: &mut Vec<Material>,
+    ) -> Result<Vec<(TriangleMesh, Option<u32>)>> {
+        let needs_file = matches!(shape.kind, ShapeKind::Obj | ShapeKind::Gltf);
+        if needs_file != shape.filename.is_some() {
+            return Err(self.error(if needs_file {
+                format!("{item}: a {:?} shape needs a filename", shape.kind).to_lowercase()
+            } else {
+                format!("{item}: only obj and gltf shapes take a filename")
+            }));
+        }
+        if shape.kind != ShapeKind::UvSphere && (shape.segments.is_some() || shape.rings.is_some()) {
+            return Err(self.error(format!("{item}: segments and rings apply to uv_sphere only")));
+        }
+        Ok(match shape.kind {
+            ShapeKind::Obj => {
+                let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
+                vec![(obj::load_obj(&file).map_err(|e| e.in_scene(self.path, item))?, None)]
+            }
+            ShapeKind::Gltf => {
+                let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
+                let import = super::gltf::import_meshes(&file, &mut self.textures, materials, pbr_tables)
+                    .map_err(|e| e.in_scene(self.path, item))?;
+                self.warnings
+                    .extend(import.warnings.into_iter().map(|w| format!("{}: {item}: {w}", self.path.display())));
+                import.meshes
+            }
+            ShapeKind::Rectangle => vec![(shapes::rectangle(), None)],
+            ShapeKind::Cube => vec![(shapes::cube(), None)],
+            ShapeKind::UvSphere => {
+                let (segments, rings) = (shape.segments.unwrap_or(64), shape.rings.unwrap_or(32));
+                if !(3..=65_536).contains(&segments) || !(2..=65_536).contains(&rings) {
+                    return Err(self.error(format!("{item}: a uv_sphere needs 3..65536 segments and 2..65536 rings")));
+                }
+                vec![(shapes::uv_sphere(segments, rings), None)]
+            }
+        })
+    }
+
+    fn environment(&mut self, env: &EnvironmentDesc) -> Result<Environment> {
+        Ok(match env {
+            EnvironmentDesc::Constant { radiance: RgbValue(c) } => {
+                if c.iter().any(|v| *v < 0.0) {
+                    return Err(self.error(format!("environment.radiance: negative radiance {c:?}")));
+                }
+                Environment::Constant(Rgb::from(*c))
+            }
+            EnvironmentDesc::Envmap { filename, scale } => {
+                if !(scale.is_finite() && *scale >= 0.0) {
+                    return Err(self.error(format!("environment.scale: {scale} is not a non-negative number")));
+                }
+                let file = self.resolve_path(filename);
+                let image = read_bitmap(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, "environment"))?;
+                Environment::Map(EnvironmentMap::new(image, *scale))
+            }
+        })
+    }
+
+    fn camera(&self, c: &CameraDesc, s: &RenderSettings) -> Result<PerspectiveCamera> {
+        let placed_by = [c.eye.is_some() || c.target.is_some(), c.matrix.is_some(), c.gltf.is_some()];
+        if placed_by.iter().filter(|p| **p).count() != 1 {
+            return Err(self.error("camera: place it with exactly one of eye/target, matrix or gltf"));
+        }
+        if c.index.is_some() && c.gltf.is_none() {
+            return Err(self.error("camera.index applies to a gltf camera only"));
+        }
+        let (to_world, gltf_fov) = if let Some(file) = &c.gltf {
+            let path = self.resolve_path(file);
+            let (m, yfov) =
+                super::gltf::import_camera(&path, c.index.unwrap_or(0)).map_err(|e| e.in_scene(self.path, "camera"))?;
+            (m, Some(yfov))
+        } else if let Some(m) = c.matrix {
+            (Mat4::from_cols_array(&m).transpose(), None)
+        } else {
+            let (Some(eye), Some(target)) = (c.eye, c.target) else {
+                return Err(self.error("camera: eye and target must both be given"));
+            };
+            let up = Vec3::from(c.up.unwrap_or([0.0, 1.0, 0.0]));
+            (
+                PerspectiveCamera::look_at(Vec3::from(eye), Vec3::from(target), up)
+                    .map_err(|e| e.in_scene(self.path, "camera"))?,
+                None,
+            )
+        };
+        let (fov, axis) = match (c.fov, gltf_fov) {
+            (Some(f), _) => (f, c.fov_axis.unwrap_or(FovAxis::Y)),
+            (None, Some(y)) => (y, FovAxis::Y),
+            (None, None) => return Err(self.error("camera.fov is required (degrees)")),
+        };
+        PerspectiveCamera::new(to_world, fov, axis, s.width, s.height, s.spp)
+            .map_err(|e| e.in_scene(self.path, "camera"))
+    }
+}
+
+/// Mitsuba's `lookat` transform: local +z towards `target`, local x = normalize(up x z).
+fn mitsuba_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
+    let dir = (target - origin).try_normalize()?;
+    let left = up.cross(dir).try_normalize()?;
+    let new_up = dir.cross(left);
+    Some(Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0)))
+}

@@ -1,0 +1,167 @@
+//! Scenes: the file format ([`desc`]), loading ([`load`]), and the loaded scene that the
+//! integrator queries.
+
+pub mod desc;
+mod gltf;
+mod load;
+
+pub use load::{SceneOverrides, load_scene, load_scene_str};
+
+use crate::accel::Accel;
+use crate::camera::PerspectiveCamera;
+use crate::geometry::{Bounds, Ray, SurfaceInteraction, TriangleMesh, TriangleVertices};
+use crate::light::Lights;
+use crate::material::Material;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
+use std::path::PathBuf;
+
+/// Image and integrator settings (the scene's `[render]` table after command-line overrides).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Longest path in segments (Mitsuba's count); None for unlimited.
+    pub max_depth: Option<u32>,
+    /// Depth from which Russian roulette applies.
+    pub rr_depth: u32,
+    /// Sampler seed.
+    pub seed: u64,
+}
+
+/// A shape as the renderer sees it after loading.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// Name for messages (`shapes[2] (sphere.obj)`).
+    pub name: String,
+    /// Index into [`Scene::materials`].
+    pub material: u32,
+    /// Index into the area lights, if the shape emits.
+    pub light: Option<u32>,
+    /// First vertex in [`Geometry`]'s arrays.
+    pub first_vertex: u32,
+    /// Whether the mesh had normals and texture coordinates.
+    pub has_normals: bool,
+    /// See `has_normals`.
+    pub has_uvs: bool,
+}
+
+/// All triangles of a scene in world space, in one set of arrays.
+#[derive(Clone, Debug, Default)]
+pub struct Geometry {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Vertex normals (zero for shapes without normals).
+    pub normals: Vec<Vec3>,
+    /// Vertex texture coordinates (zero for shapes without them).
+    pub uvs: Vec<Vec2>,
+    /// Triangles as indices into the vertex arrays.
+    pub triangles: Vec<[u32; 3]>,
+    /// Shape of each triangle.
+    pub triangle_shape: Vec<u32>,
+    /// Shapes.
+    pub shapes: Vec<Shape>,
+}
+
+impl Geometry {
+    /// Append a mesh as a new shape.
+    pub fn add(&mut self, mesh: TriangleMesh, name: String, material: u32, light: Option<u32>) {
+        let first = self.positions.len() as u32;
+        let n = mesh.positions.len();
+        let shape = self.shapes.len() as u32;
+        self.shapes.push(Shape {
+            name,
+            material,
+            light,
+            first_vertex: first,
+            has_normals: mesh.normals.is_some(),
+            has_uvs: mesh.uvs.is_some(),
+        });
+        self.positions.extend(&mesh.positions);
+        self.normals.extend(mesh.normals.unwrap_or_else(|| vec![Vec3::ZERO; n]));
+        self.uvs.extend(mesh.uvs.unwrap_or_else(|| vec![Vec2::ZERO; n]));
+        self.triangles.extend(mesh.indices.iter().map(|t| t.map(|i| i + first)));
+        self.triangle_shape.extend(std::iter::repeat_n(shape, mesh.indices.len()));
+    }
+
+    /// Vertex positions of triangle `i`.
+    #[inline]
+    pub fn triangle_positions(&self, i: usize) -> [Vec3; 3] {
+        self.triangles[i].map(|v| self.positions[v as usize])
+    }
+
+    /// All vertex data of triangle `i`.
+    #[inline]
+    pub fn triangle_vertices(&self, i: usize) -> TriangleVertices {
+        let idx = self.triangles[i];
+        let shape = &self.shapes[self.triangle_shape[i] as usize];
+        TriangleVertices {
+            p: idx.map(|v| self.positions[v as usize]),
+            n: shape.has_normals.then(|| idx.map(|v| self.normals[v as usize])),
+            uv: shape.has_uvs.then(|| idx.map(|v| self.uvs[v as usize])),
+        }
+    }
+
+    /// Bounding box of all vertices.
+    pub fn bounds(&self) -> Bounds {
+        let mut b = Bounds::EMPTY;
+        for p in &self.positions {
+            b.include(*p);
+        }
+        b
+    }
+}
+
+/// A loaded scene, ready to render.
+pub struct Scene {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Image and integrator settings.
+    pub settings: RenderSettings,
+    /// The camera.
+    pub camera: PerspectiveCamera,
+    /// Triangles and shapes.
+    pub geometry: Geometry,
+    /// Ray intersection over `geometry`.
+    pub accel: Accel,
+    /// Materials; shapes index them.
+    pub materials: Vec<Material>,
+    /// Textures; materials index them.
+    pub textures: Vec<Texture>,
+    /// Lights.
+    pub lights: Lights,
+    /// Problems found while loading that did not stop it (degenerate triangles dropped, glTF
+    /// features ignored).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// The closest surface along `ray`.
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        let hit = self.accel.intersect(ray)?;
+        let tri = self.geometry.triangle_vertices(hit.triangle as usize);
+        Some(SurfaceInteraction::from_triangle(&tri, hit.b1, hit.b2, hit.t, ray, hit.triangle))
+    }
+
+    /// True when something blocks `ray` before its `t_max`.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.accel.occluded(ray)
+    }
+
+    /// The shape a triangle belongs to.
+    #[inline]
+    pub fn shape_of(&self, triangle: u32) -> &Shape {
+        &self.geometry.shapes[self.geometry.triangle_shape[triangle as usize] as usize]
+    }
+
+    /// Approximate memory held by geometry, acceleration structure and textures, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        let g = &self.geometry;
+        let geometry = g.positions.len() * (12 + 12 + 8) + g.triangles.len() * (12 + 4);
+        geometry + self.accel.memory_bytes() + self.textures.iter().map(Texture::memory_bytes).sum::<usize>()
+    }
+}
