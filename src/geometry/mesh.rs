@@ -111,6 +111,17 @@ impl TriangleMesh {
         }
     }
 
+    /// Turn the mesh inside out: reverse the winding and negate the normals (Mitsuba's
+    /// `flip_normals`), so that the front faces the other way.
+    pub fn flip_normals(&mut self) {
+        for t in &mut self.indices {
+            t.swap(1, 2);
+        }
+        if let Some(normals) = &mut self.normals {
+            normals.iter_mut().for_each(|n| *n = -*n);
+        }
+    }
+
     /// Check the mesh for unusable data and drop degenerate triangles.
     ///
     /// Errors (returned as a message for the caller to attach the file name to): non-finite

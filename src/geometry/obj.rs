@@ -17,41 +17,33 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh> {
         },
         other => Error::mesh(path, format!("malformed OBJ: {other}")),
     })?;
-    let mut mesh = TriangleMesh { normals: Some(Vec::new()), uvs: Some(Vec::new()), ..Default::default() };
-    let (mut with_normals, mut with_uvs) = (0usize, 0usize);
+    let (mut positions, mut normals, mut uvs, mut indices) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for model in &models {
         let m = &model.mesh;
-        let base = mesh.positions.len() as u32;
+        let base = positions.len() as u32;
         let count = m.positions.len() / 3;
-        mesh.positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         if m.normals.len() == m.positions.len() {
-            with_normals += count;
-            let normals = m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2]));
-            mesh.normals.as_mut().map(|ns| ns.extend(normals));
+            normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         }
-        if m.texcoords.len() / 2 == count && !m.texcoords.is_empty() {
-            with_uvs += count;
-            let uvs = m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1]));
-            if let Some(out) = mesh.uvs.as_mut() {
-                out.extend(uvs);
-            }
+        if m.texcoords.len() / 2 == count {
+            uvs.extend(m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
         }
         if m.indices.len() % 3 != 0 {
             return Err(Error::mesh(path, format!("object '{}' has an incomplete triangle", model.name)));
         }
-        mesh.indices.extend(m.indices.chunks_exact(3).map(|c| [base + c[0], base + c[1], base + c[2]]));
+        indices.extend(m.indices.chunks_exact(3).map(|c| [base + c[0], base + c[1], base + c[2]]));
     }
-    let n = mesh.positions.len();
-    for (have, what) in [(with_normals, "normals"), (with_uvs, "texture coordinates")] {
-        if have != 0 && have != n {
-            return Err(Error::mesh(path, format!("only {have} of {n} vertices have {what}")));
-        }
-    }
-    if with_normals == 0 {
-        mesh.normals = None;
-    }
-    if with_uvs == 0 {
-        mesh.uvs = None;
-    }
+    let n = positions.len();
+    // An attribute counts only if every vertex has it.
+    let complete = |have: usize, what: &str| match have {
+        0 => Ok(false),
+        h if h == n => Ok(true),
+        h => Err(Error::mesh(path, format!("only {h} of {n} vertices have {what}"))),
+    };
+    let has_normals = complete(normals.len(), "normals")?;
+    let has_uvs = complete(uvs.len(), "texture coordinates")?;
+    let mesh =
+        TriangleMesh { positions, normals: has_normals.then_some(normals), uvs: has_uvs.then_some(uvs), indices };
     Ok(mesh)
 }

@@ -54,11 +54,12 @@ impl AreaLight {
         Some(LightSample { wi, radiance: self.radiance, pdf, point: Some(offset_ray_origin(q, n, -wi)) })
     }
 
-    /// Solid-angle density at `p` of sampling the point `q` with geometric normal `n`.
+    /// Solid-angle density at `p` of sampling the point `q` with geometric normal `n`; zero where
+    /// `p` sees the back of the light, since [`AreaLight::sample`] returns nothing there.
     pub fn pdf(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
-        let d = q - p;
+        let d = p - q;
         let dist2 = d.length_squared();
-        let cos = n.dot(d).abs() / dist2.sqrt();
-        if cos == 0.0 { 0.0 } else { dist2 / (cos * self.area) }
+        let cos = n.dot(d) / dist2.sqrt();
+        if !(cos > 0.0) { 0.0 } else { dist2 / (cos * self.area) }
     }
 }

@@ -107,11 +107,17 @@ impl Environment {
             Environment::Constant(_) => (warp::square_to_uniform_sphere(u), warp::UNIFORM_SPHERE_PDF),
             Environment::Map(m) => {
                 let (uv, pdf_uv) = m.distribution.sample(u);
-                let sin_theta = (uv.y * PI).sin();
-                if sin_theta <= 0.0 || pdf_uv <= 0.0 {
+                if pdf_uv <= 0.0 {
                     return None;
                 }
-                (uv_to_direction(uv), pdf_uv / (2.0 * PI * PI * sin_theta))
+                let wi = uv_to_direction(uv);
+                // The density as `pdf` computes it from the direction, so that MIS weights use one
+                // function (a sample on a cell edge may round into the neighbouring cell).
+                let pdf = self.pdf(wi);
+                if pdf <= 0.0 {
+                    return None;
+                }
+                (wi, pdf)
             }
         };
         Some(LightSample { wi, radiance: self.radiance(wi), pdf, point: None })

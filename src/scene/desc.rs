@@ -237,6 +237,9 @@ pub struct ShapeDesc {
     /// Transform steps, applied in order.
     #[serde(default)]
     pub transform: Vec<TransformStep>,
+    /// Turn the shape inside out (its front, and the side an emitter lights, become the back).
+    #[serde(default)]
+    pub flip_normals: bool,
 }
 
 /// Kinds of shapes.

@@ -144,6 +144,9 @@ impl<'a> Loader<'a> {
             for (mesh, material) in self.shape_meshes(shape, &item, &mut materials)? {
                 let mut mesh = mesh;
                 mesh.transform(&transform);
+                if shape.flip_normals {
+                    mesh.flip_normals();
+                }
                 let cleanup = mesh.validate().map_err(|msg| self.error(format!("{item}: {msg}")))?;
                 if cleanup.degenerate_triangles > 0 {
                     self.warnings.push(format!(

@@ -1,0 +1,92 @@
+//! Chi-square goodness of fit of light sampling against the densities the integrator uses for
+//! multiple importance sampling: environment maps and area lights.
+
+mod common;
+
+use common::{Chi2, sidak};
+use glam::{Vec2, Vec3};
+use tessera::accel::Accel;
+use tessera::geometry::Ray;
+use tessera::image::{Bitmap, ColorSpace, read_bitmap};
+use tessera::light::{AreaLight, Environment, EnvironmentMap};
+
+const TESTS: usize = 4;
+
+#[test]
+fn environment_map_sampling_matches_pdf_chi2() {
+    // A coarse map (each texel spans many chi-square nodes, so the density's jumps at texel
+    // edges integrate accurately), with a bright "sun" texel and a dark band.
+    let mut image = Bitmap::new(16, 8, 3);
+    for y in 0..8 {
+        for x in 0..16 {
+            let v = 0.2 + 0.1 * ((x * 7 + y * 3) % 5) as f32 + if y == 6 { -0.15 } else { 0.0 };
+            let sun = if (x, y) == (11, 2) { 40.0 } else { 0.0 };
+            image.values_mut(x, y).copy_from_slice(&[v + sun, v, v * 0.5 + sun]);
+        }
+    }
+    let env = Environment::Map(EnvironmentMap::new(image, 1.0));
+    let outcome = Chi2::default().run(21, |_, u| env.sample(u).map(|s| s.wi), |w| env.pdf(w));
+    assert!(outcome.p_value > sidak(TESTS) && outcome.in_zero_cells == 0, "{outcome:?}");
+    assert!((outcome.integral - 1.0).abs() < 2e-3, "{outcome:?}");
+}
+
+#[test]
+fn environment_map_sample_pdf_and_radiance_are_consistent() {
+    // On the shipped sky map (sun 22672): each sample's pdf equals pdf(direction), and the
+    // importance-sampled estimate of the mean radiance matches a quadrature of the map.
+    let image = read_bitmap(&common::repo().join("scenes/textures/sky_512x256.exr"), ColorSpace::Linear).unwrap();
+    let env = Environment::Map(EnvironmentMap::new(image, 1.0));
+    let n = 200_000;
+    let mut estimate = 0.0f64;
+    for i in 0..n {
+        let mut s = tessera::sampling::Sampler::new(8, 0, i);
+        let ls = env.sample(s.next_2d()).expect("the map has energy");
+        let pdf = env.pdf(ls.wi);
+        assert!((pdf - ls.pdf).abs() <= 2e-3 * pdf, "{pdf} vs {}", ls.pdf);
+        estimate += (ls.radiance.y / ls.pdf) as f64;
+    }
+    estimate /= n as f64;
+    let quadrature = common::integrate_sphere(400, |w| env.radiance(w).y as f64);
+    // Importance sampling by luminance leaves little variance in the green channel.
+    assert!((estimate - quadrature).abs() < 0.01 * quadrature, "estimate {estimate}, quadrature {quadrature}");
+}
+
+#[test]
+fn constant_environment_sampling_is_uniform_chi2() {
+    let env = Environment::Constant(Vec3::ONE);
+    let outcome = Chi2::default().run(22, |_, u| env.sample(u).map(|s| s.wi), |w| env.pdf(w));
+    assert!(outcome.p_value > sidak(TESTS) && (outcome.integral - 1.0).abs() < 1e-3, "{outcome:?}");
+}
+
+#[test]
+fn area_light_sampling_matches_pdf_chi2() {
+    // A tilted quad facing the point, a triangle of another size facing it, and a triangle
+    // showing it its back (never sampled: zero density there).
+    let quad = [
+        [Vec3::new(-1.0, -0.5, 1.0), Vec3::new(1.0, 0.5, 1.2), Vec3::new(1.0, -0.5, 1.2)],
+        [Vec3::new(-1.0, -0.5, 1.0), Vec3::new(-1.0, 0.5, 1.0), Vec3::new(1.0, 0.5, 1.2)],
+        [Vec3::new(0.5, 1.0, 0.3), Vec3::new(0.8, 2.0, 0.4), Vec3::new(1.5, 1.2, 0.5)],
+        [Vec3::new(-1.5, -1.0, 0.2), Vec3::new(-1.0, -2.0, 0.2), Vec3::new(-0.5, -1.5, 0.3)],
+    ];
+    let light = AreaLight::new(quad.to_vec(), Vec3::ONE);
+    let accel = Accel::build(&quad);
+    let p = Vec3::new(0.1, 0.2, -0.3);
+    let pdf = |w: Vec3| {
+        let Some(hit) = accel.intersect(&Ray::new(p, w)) else { return 0.0 };
+        let [a, b, c] = quad[hit.triangle as usize];
+        let q = a * (1.0 - hit.b1 - hit.b2) + b * hit.b1 + c * hit.b2;
+        light.pdf(p, q, (b - a).cross(c - a).normalize())
+    };
+    // The density ends abruptly at the triangles' edges: integrate finely (40 x 40 nodes).
+    let chi2 = Chi2 { nodes: 40, ..Chi2::default() };
+    let outcome = chi2.run(23, |_, u: Vec2| light.sample(p, u).map(|s| s.wi), pdf);
+    assert!(outcome.p_value > sidak(TESTS) && outcome.in_zero_cells == 0, "{outcome:?}");
+    // The back-facing triangle's share of the area produces no samples.
+    let facing: f32 = quad[..3].iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).sum();
+    let expected = facing / light.area();
+    let fraction = outcome.valid as f32 / 400_000.0;
+    assert!(
+        (fraction - expected).abs() < 0.005 && (outcome.integral as f32 - expected).abs() < 0.005,
+        "{outcome:?}, expected {expected}"
+    );
+}

@@ -1,0 +1,197 @@
+//! Helpers shared by the integration tests: scenes from strings, renders, and the chi-square
+//! goodness-of-fit harness.
+#![allow(dead_code)] // each test file uses a subset
+
+use glam::{Vec2, Vec3};
+use std::path::{Path, PathBuf};
+use tessera::image::Film;
+use tessera::integrator::render;
+use tessera::sampling::Sampler;
+use tessera::scene::{Scene, SceneOverrides, load_scene};
+
+/// The repository root (for shipped scenes and test data).
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Write `toml` as `scene.toml` (and `files` beside it) in a fresh temporary folder.
+pub fn scene_dir(toml: &str, files: &[(&str, &[u8])]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    std::fs::write(dir.path().join("scene.toml"), toml).unwrap();
+    for (name, bytes) in files {
+        let p = dir.path().join(name);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        std::fs::write(p, bytes).unwrap();
+    }
+    dir
+}
+
+/// Load `scene.toml` from a folder made by [`scene_dir`].
+pub fn load(dir: &Path) -> tessera::Result<Scene> {
+    load_scene(&dir.join("scene.toml"), &SceneOverrides::default())
+}
+
+/// Load a scene given as text (with files beside it), panicking on errors.
+pub fn scene(toml: &str, files: &[(&str, &[u8])]) -> (tempfile::TempDir, Scene) {
+    let dir = scene_dir(toml, files);
+    let scene = load(dir.path()).unwrap_or_else(|e| panic!("scene failed to load: {e}"));
+    (dir, scene)
+}
+
+/// Render the whole image on the current thread pool.
+pub fn render_film(scene: &Scene) -> Film {
+    render(scene, None, &[], &|_, _| {})
+}
+
+/// Mean and standard error of the mean of the red channel over all pixels, from the film's
+/// per-pixel variance (independent pixels).
+pub fn mean_and_error(film: &Film, spp: u32) -> (f64, f64) {
+    let r = film.radiance();
+    let v = film.variance();
+    let n = (r.width * r.height) as f64;
+    let mean = r.data.iter().step_by(3).map(|&x| x as f64).sum::<f64>() / n;
+    let var_of_mean = v.data.iter().step_by(3).map(|&x| x as f64 / spp as f64).sum::<f64>() / (n * n);
+    (mean, var_of_mean.sqrt())
+}
+
+/// Settings of a chi-square test over directions on the unit sphere, binned in
+/// (z, phi), which is equal-area: the solid angle of a cell is dz dphi.
+pub struct Chi2 {
+    /// Bins along z = cos(theta) in [-1, 1].
+    pub z_bins: usize,
+    /// Bins along phi in [0, 2 pi).
+    pub phi_bins: usize,
+    /// Samples drawn.
+    pub samples: usize,
+    /// Gauss-Legendre nodes per cell side when integrating the density.
+    pub nodes: usize,
+    /// Cells whose expected count is below this are pooled into one (pbrt-v4: 5).
+    pub min_expected: f64,
+}
+
+impl Default for Chi2 {
+    fn default() -> Self {
+        Chi2 { z_bins: 40, phi_bins: 80, samples: 400_000, nodes: 16, min_expected: 5.0 }
+    }
+}
+
+/// Outcome of a chi-square test.
+#[derive(Debug)]
+pub struct Chi2Outcome {
+    pub p_value: f64,
+    pub statistic: f64,
+    pub dof: usize,
+    /// Samples that landed in a cell whose integrated density is zero.
+    pub in_zero_cells: usize,
+    /// Valid samples and the integral of the density over the sphere.
+    pub valid: usize,
+    pub integral: f64,
+}
+
+fn cell_of(w: Vec3, z_bins: usize, phi_bins: usize) -> usize {
+    let z = ((w.z.clamp(-1.0, 1.0) + 1.0) * 0.5 * z_bins as f32) as usize;
+    let mut phi = w.y.atan2(w.x);
+    if phi < 0.0 {
+        phi += std::f32::consts::TAU;
+    }
+    let p = (phi / std::f32::consts::TAU * phi_bins as f32) as usize;
+    z.min(z_bins - 1) * phi_bins + p.min(phi_bins - 1)
+}
+
+impl Chi2 {
+    /// Draw samples with `sample(u1, u2)` (None: no direction) and compare their histogram with
+    /// the density `pdf`, integrated over each cell.
+    pub fn run(&self, seed: u64, sample: impl Fn(f32, Vec2) -> Option<Vec3>, pdf: impl Fn(Vec3) -> f32) -> Chi2Outcome {
+        let cells = self.z_bins * self.phi_bins;
+        let mut observed = vec![0usize; cells];
+        let mut valid = 0;
+        for i in 0..self.samples {
+            let mut s = Sampler::new(seed, 0, i as u32);
+            let u1 = s.next_1d();
+            let u2 = s.next_2d();
+            if let Some(w) = sample(u1, u2) {
+                assert!((w.length() - 1.0).abs() < 1e-3, "sampled direction {w} is not unit length");
+                observed[cell_of(w, self.z_bins, self.phi_bins)] += 1;
+                valid += 1;
+            }
+        }
+        let (x, wts) = tessera::math::gauss_legendre(self.nodes);
+        let mut expected = vec![0.0f64; cells];
+        let dz = 2.0 / self.z_bins as f64;
+        let dphi = std::f64::consts::TAU / self.phi_bins as f64;
+        for zi in 0..self.z_bins {
+            for pi in 0..self.phi_bins {
+                let mut integral = 0.0;
+                for (a, wa) in x.iter().zip(&wts) {
+                    let z = -1.0 + dz * (zi as f64 + 0.5 + 0.5 * a);
+                    let r = (1.0 - z * z).max(0.0).sqrt();
+                    for (b, wb) in x.iter().zip(&wts) {
+                        let phi = dphi * (pi as f64 + 0.5 + 0.5 * b);
+                        let w = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
+                        integral += wa * wb * pdf(w) as f64;
+                    }
+                }
+                expected[zi * self.phi_bins + pi] = integral * 0.25 * dz * dphi * self.samples as f64;
+            }
+        }
+        let integral = expected.iter().sum::<f64>() / self.samples as f64;
+        let in_zero_cells = observed.iter().zip(&expected).filter(|(_, e)| **e == 0.0).map(|(o, _)| *o).sum();
+        // Pool the cells with small expected counts (their chi-square terms are unreliable).
+        let (mut stat, mut dof) = (0.0, 0usize);
+        let (mut pooled_o, mut pooled_e) = (0.0, 0.0);
+        for (o, e) in observed.iter().zip(&expected) {
+            if *e < self.min_expected {
+                pooled_o += *o as f64;
+                pooled_e += e;
+            } else {
+                stat += (*o as f64 - e).powi(2) / e;
+                dof += 1;
+            }
+        }
+        if pooled_e >= self.min_expected {
+            stat += (pooled_o - pooled_e).powi(2) / pooled_e;
+            dof += 1;
+        } else if pooled_o > 0.0 {
+            // A few stray samples where almost nothing is expected.
+            stat += (pooled_o - pooled_e).powi(2) / pooled_e.max(1.0);
+            dof += 1;
+        }
+        let dof = dof.saturating_sub(1).max(1);
+        use statrs::distribution::{ChiSquared, ContinuousCDF};
+        let p_value = ChiSquared::new(dof as f64).unwrap().sf(stat);
+        Chi2Outcome { p_value, statistic: stat, dof, in_zero_cells, valid, integral }
+    }
+}
+
+/// Per-test significance for `tests` tests sharing an overall level of 0.01 (Sidak).
+pub fn sidak(tests: usize) -> f64 {
+    1.0 - (1.0f64 - 0.01).powf(1.0 / tests as f64)
+}
+
+/// A unit direction from spherical angles in degrees (theta from +z).
+pub fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
+
+/// Integrate `f` over the unit sphere with `n` x 2n Gauss-Legendre cells in (z, phi).
+pub fn integrate_sphere(n: usize, f: impl Fn(Vec3) -> f64) -> f64 {
+    let (x, w) = tessera::math::gauss_legendre(4);
+    let dz = 2.0 / n as f64;
+    let dphi = std::f64::consts::PI / n as f64;
+    let mut sum = 0.0;
+    for zi in 0..n {
+        for pi in 0..2 * n {
+            for (a, wa) in x.iter().zip(&w) {
+                let z = -1.0 + dz * (zi as f64 + 0.5 + 0.5 * a);
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                for (b, wb) in x.iter().zip(&w) {
+                    let phi = dphi * (pi as f64 + 0.5 + 0.5 * b);
+                    let d = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
+                    sum += wa * wb * f(d);
+                }
+            }
+        }
+    }
+    sum * 0.25 * dz * dphi
+}
