@@ -7,30 +7,23 @@
 //!
 //! ```
 //! use tessera::scene::{load_scene_str, SceneOverrides};
-//! // A diffuse square lit by a white environment: a furnace.
+//! // A camera looking at a square light: every pixel sees exactly its radiance.
 //! let scene = load_scene_str(r#"
 //!     [render]
 //!     width = 8
 //!     height = 8
 //!     spp = 4
 //!     [camera]
-//!     fov = 30
+//!     fov = 20
 //!     eye = [0, 0, 5]
 //!     target = [0, 0, 0]
-//!     [environment]
-//!     type = "constant"
-//!     radiance = 1.0
-//!     [materials.white]
-//!     type = "diffuse"
-//!     reflectance = 0.8
 //!     [[shapes]]
 //!     type = "rectangle"
-//!     material = "white"
+//!     emission = [2.5, 1.0, 0.5]
 //! "#, std::path::Path::new("inline.toml"), &SceneOverrides::default()).unwrap();
 //! let film = tessera::integrator::render(&scene, None, &[], &|_, _| {});
-//! // A flat diffuse surface under a uniform sky reflects albedo x radiance.
-//! let centre = film.radiance().pixel(4, 4);
-//! assert!((centre.x - 0.8).abs() < 1e-3);
+//! let image = film.radiance();
+//! assert_eq!(image.values(3, 4), &[2.5, 1.0, 0.5]);
 //! ```
 
 #![warn(missing_docs)]
