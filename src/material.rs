@@ -144,6 +144,24 @@ pub struct Material {
     pub two_sided: bool,
 }
 
+impl ColorParam {
+    fn texture(&self) -> Option<TextureId> {
+        match *self {
+            ColorParam::Value(_) => None,
+            ColorParam::Texture { id, .. } => Some(id),
+        }
+    }
+}
+
+impl FloatParam {
+    fn texture(&self) -> Option<TextureId> {
+        match *self {
+            FloatParam::Value(_) => None,
+            FloatParam::Texture { id, .. } => Some(id),
+        }
+    }
+}
+
 impl Material {
     /// The default material of a shape without one (Mitsuba's: diffuse, reflectance 0.5).
     pub fn default_diffuse() -> Self {
@@ -152,6 +170,27 @@ impl Material {
             normal_map: None,
             two_sided: false,
         }
+    }
+
+    /// The textures this material reads.
+    pub fn textures(&self) -> Vec<TextureId> {
+        let roughness = |r: &Option<Roughness>| r.map_or([None, None], |r| [r.alpha_u.texture(), r.alpha_v.texture()]);
+        let ids: Vec<Option<TextureId>> = match &self.kind {
+            MaterialKind::Diffuse { reflectance } => vec![reflectance.texture()],
+            MaterialKind::Conductor { roughness: r, specular_reflectance, .. } => {
+                [roughness(r).as_slice(), &[specular_reflectance.texture()]].concat()
+            }
+            MaterialKind::Dielectric { roughness: r, specular_reflectance, specular_transmittance, .. } => {
+                [roughness(r).as_slice(), &[specular_reflectance.texture(), specular_transmittance.texture()]].concat()
+            }
+            MaterialKind::Plastic { diffuse_reflectance, specular_reflectance, .. } => {
+                vec![diffuse_reflectance.texture(), specular_reflectance.texture()]
+            }
+            MaterialKind::Pbr { base_color, metallic, roughness, .. } => {
+                vec![base_color.texture(), metallic.texture(), roughness.texture()]
+            }
+        };
+        ids.into_iter().chain([self.normal_map]).flatten().collect()
     }
 
     /// The BSDF at a lookup.

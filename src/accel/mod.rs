@@ -30,7 +30,7 @@ pub struct Accel {
     /// None when there are no triangles.
     bvh: Option<CwBvh>,
     /// Vertices in BVH leaf order, so traversal reads them sequentially.
-    vertices: Vec<[Vec3; 3]>,
+    vertices: Vec<[Vec3A; 3]>,
     /// BVH leaf slot -> index into the triangles the accelerator was built from.
     ids: Vec<u32>,
 }
@@ -49,7 +49,7 @@ impl Accel {
             &mut std::time::Duration::default(),
         );
         let ids = bvh.primitive_indices.clone();
-        let vertices = ids.iter().map(|&i| triangles[i as usize]).collect();
+        let vertices = ids.iter().map(|&i| triangles[i as usize].map(Vec3A::from)).collect();
         Accel { bvh: Some(bvh), vertices, ids }
     }
 
@@ -61,7 +61,7 @@ impl Accel {
     /// Approximate memory held, in bytes.
     pub fn memory_bytes(&self) -> usize {
         let nodes = self.bvh.as_ref().map_or(0, |b| b.nodes.len() * size_of::<obvhs::cwbvh::node::CwBvhNode>());
-        nodes + self.vertices.len() * size_of::<[Vec3; 3]>() + self.ids.len() * 8
+        nodes + self.vertices.len() * size_of::<[Vec3A; 3]>() + self.ids.len() * 8
     }
 
     fn obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
@@ -123,7 +123,7 @@ mod tests {
         let mut best: Option<(f32, u32)> = None;
         for (i, t) in tris.iter().enumerate() {
             let t_max = best.map_or(ray.t_max, |b| b.0);
-            if let Some((t, _, _)) = shear.intersect(t, t_max) {
+            if let Some((t, _, _)) = shear.intersect(&t.map(Vec3A::from), t_max) {
                 best = Some((t, i as u32));
             }
         }

@@ -33,6 +33,10 @@ pub struct PathTracer<'a> {
     scene: &'a Scene,
     max_depth: u32,
     rr_depth: u32,
+    /// Per material: whether a hit on it needs the texture footprint.
+    needs_footprint: Vec<bool>,
+    /// Whether the first hit's footprint is recorded (the footprint AOV).
+    record_footprint: bool,
 }
 
 /// How the previous vertex sampled the current ray, for MIS at the next emitter hit.
@@ -43,9 +47,21 @@ struct PreviousVertex {
 }
 
 impl<'a> PathTracer<'a> {
-    /// A tracer with the scene's settings.
-    pub fn new(scene: &'a Scene) -> Self {
-        PathTracer { scene, max_depth: scene.settings.max_depth.unwrap_or(u32::MAX), rr_depth: scene.settings.rr_depth }
+    /// A tracer with the scene's settings; `record_footprint` computes the first hit's texture
+    /// footprint even where no filtered texture needs it.
+    pub fn new(scene: &'a Scene, record_footprint: bool) -> Self {
+        let needs_footprint = scene
+            .materials
+            .iter()
+            .map(|m| m.textures().iter().any(|id| scene.textures[id.0 as usize].uses_footprint()))
+            .collect();
+        PathTracer {
+            scene,
+            max_depth: scene.settings.max_depth.unwrap_or(u32::MAX),
+            rr_depth: scene.settings.rr_depth,
+            needs_footprint,
+            record_footprint,
+        }
     }
 
     /// Radiance arriving along the camera ray `ray` (with differentials `diff`).
@@ -90,9 +106,11 @@ impl<'a> PathTracer<'a> {
                 break;
             }
 
-            // Texture footprint: from the camera ray's differentials at the first hit, from the
-            // camera-based approximation after (pbrt-v4).
-            if depth > 0 || !si.footprint_from_differential(diff) {
+            // Texture footprint, where a filtered texture needs it: from the camera ray's
+            // differentials at the first hit, from the camera-based approximation after (pbrt-v4).
+            let wants_footprint =
+                self.needs_footprint[shape.material as usize] || (depth == 0 && self.record_footprint);
+            if wants_footprint && (depth > 0 || !si.footprint_from_differential(diff)) {
                 let (dpdx, dpdy) = scene.camera.approximate_dp_dxy(si.p, si.ng);
                 si.set_footprint(dpdx, dpdy);
             }

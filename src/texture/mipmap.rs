@@ -74,6 +74,21 @@ fn downsample_axis(src: &Bitmap, new_len: usize, horizontal: bool) -> Bitmap {
     out
 }
 
+/// `i` modulo `n` in [0, n); lookups fall at most one texel outside, so avoid the division then.
+#[inline(always)]
+fn wrap(i: i64, n: usize) -> usize {
+    let n = n as i64;
+    if (0..n).contains(&i) {
+        i as usize
+    } else if (-n..0).contains(&i) {
+        (i + n) as usize
+    } else if (n..2 * n).contains(&i) {
+        (i - n) as usize
+    } else {
+        i.rem_euclid(n) as usize
+    }
+}
+
 impl MipMap {
     /// Build the pyramid: each level halves each side (rounding down, at least 1).
     pub fn new(base: Bitmap) -> Self {
@@ -109,7 +124,7 @@ impl MipMap {
     #[inline]
     fn texel(&self, level: usize, x: i64, y: i64) -> Vec4 {
         let l = &self.levels[level];
-        l.pixel(x.rem_euclid(l.width as i64) as usize, y.rem_euclid(l.height as i64) as usize)
+        l.pixel(wrap(x, l.width), wrap(y, l.height))
     }
 
     /// Bilinear interpolation of `level` at `st` (image coordinates in [0, 1]: x right, y down),

@@ -96,6 +96,11 @@ impl Texture {
         }
     }
 
+    /// True when lookups use the footprint (a filtered image), so hits must compute it.
+    pub fn uses_footprint(&self) -> bool {
+        matches!(self, Texture::Image(t) if t.filter != Filter::None)
+    }
+
     /// Approximate memory held, in bytes.
     pub fn memory_bytes(&self) -> usize {
         match self {
