@@ -163,13 +163,11 @@ impl FloatParam {
 }
 
 impl Material {
-    /// The default material of a shape without one (Mitsuba's: diffuse, reflectance 0.5).
-    pub fn default_diffuse() -> Self {
-        Material {
-            kind: MaterialKind::Diffuse { reflectance: ColorParam::Value(Rgb::splat(0.5)) },
-            normal_map: None,
-            two_sided: false,
-        }
+    /// The default material of a shape without one, as Mitsuba 3 (`Shape::Shape`) makes it:
+    /// diffuse with reflectance 0.5, or 0 (black) if the shape is an emitter.
+    pub fn default_diffuse(emitter: bool) -> Self {
+        let reflectance = ColorParam::Value(Rgb::splat(if emitter { 0.0 } else { 0.5 }));
+        Material { kind: MaterialKind::Diffuse { reflectance }, normal_map: None, two_sided: false }
     }
 
     /// The textures this material reads.

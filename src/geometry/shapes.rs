@@ -6,14 +6,18 @@ use super::TriangleMesh;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
-/// Mitsuba's `rectangle`: the square [-1, 1]^2 in the plane z = 0, front face towards +z,
-/// uv = ((x + 1) / 2, (y + 1) / 2).
+/// Mitsuba's `rectangle`: the square [-1, 1]^2 in the plane z = 0, front face towards +z.
+///
+/// Mitsuba gives it uv = ((x + 1) / 2, (y + 1) / 2) in *its* convention, where uv (0, 0) is a
+/// bitmap's top-left texel (only its OBJ loader flips v). In tessera's convention (origin at the
+/// bottom-left, DESIGN.md section 3) the same lookups are uv = ((x + 1) / 2, (1 - y) / 2): the
+/// image's top-left corner lies at (-1, -1), as in Mitsuba.
 pub fn rectangle() -> TriangleMesh {
     let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
     TriangleMesh {
         positions: corners.iter().map(|&(x, y)| Vec3::new(x, y, 0.0)).collect(),
         normals: Some(vec![Vec3::Z; 4]),
-        uvs: Some(corners.iter().map(|&(x, y)| Vec2::new((x + 1.0) / 2.0, (y + 1.0) / 2.0)).collect()),
+        uvs: Some(corners.iter().map(|&(x, y)| Vec2::new((x + 1.0) / 2.0, (1.0 - y) / 2.0)).collect()),
         indices: vec![[0, 1, 2], [0, 2, 3]],
     }
 }
@@ -129,10 +133,14 @@ mod tests {
     }
 
     #[test]
-    fn rectangle_uv_matches_mitsuba() {
+    fn rectangle_lookups_match_mitsuba() {
+        // Mitsuba's uv (u_m, v_m) = ((x + 1) / 2, (y + 1) / 2) reads the image row v_m H from the
+        // top; tessera's (u, v) reads row (1 - v) H from the top. The rows must agree.
         let m = rectangle();
         for (p, uv) in m.positions.iter().zip(m.uvs.as_ref().unwrap()) {
-            assert_eq!(*uv, Vec2::new((p.x + 1.0) / 2.0, (p.y + 1.0) / 2.0));
+            let mitsuba_row_from_top = (p.y + 1.0) / 2.0;
+            assert_eq!(uv.x, (p.x + 1.0) / 2.0);
+            assert_eq!(1.0 - uv.y, mitsuba_row_from_top);
         }
         let [a, b, c] = m.triangle(0);
         assert!((b - a).cross(c - a).z > 0.0);

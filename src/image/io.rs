@@ -244,6 +244,19 @@ mod tests {
     }
 
     #[test]
+    fn jpeg_is_decoded_with_srgb_or_linear() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.jpg");
+        ::image::RgbImage::from_pixel(8, 8, ::image::Rgb([200, 200, 200])).save(&path).unwrap();
+        let srgb = read_bitmap(&path, ColorSpace::Srgb).unwrap();
+        let linear = read_bitmap(&path, ColorSpace::Linear).unwrap();
+        assert_eq!((srgb.width, srgb.height, srgb.channels), (8, 8, 3));
+        // JPEG is lossy: within a couple of code values of 200.
+        assert!((srgb.data[0] - 0.5776).abs() < 0.01, "{}", srgb.data[0]);
+        assert!((linear.data[0] - 200.0 / 255.0).abs() < 0.01, "{}", linear.data[0]);
+    }
+
+    #[test]
     fn failed_write_keeps_the_old_file() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("keep.exr");

@@ -115,8 +115,8 @@ impl<'a> Loader<'a> {
             material_ids.insert(name.clone(), materials.len() as u32);
             materials.push(material);
         }
-        let mut default_material = None;
-
+        // The default materials, made when first needed: for plain shapes and for emitters.
+        let mut default_material = [None, None];
         let mut geometry = Geometry::default();
         let mut lights = Lights::default();
         for (i, shape) in desc.shapes.iter().enumerate() {
@@ -157,8 +157,8 @@ impl<'a> Loader<'a> {
                 }
                 let material = match assigned.or(material) {
                     Some(m) => m,
-                    None => *default_material.get_or_insert_with(|| {
-                        materials.push(Material::default_diffuse());
+                    None => *default_material[usize::from(emission.is_some())].get_or_insert_with(|| {
+                        materials.push(Material::default_diffuse(emission.is_some()));
                         materials.len() as u32 - 1
                     }),
                 };
@@ -582,4 +582,29 @@ fn mitsuba_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
     let left = up.cross(dir).try_normalize()?;
     let new_up = dir.cross(left);
     Some(Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::{ColorParam, MaterialKind};
+
+    #[test]
+    fn default_materials_follow_mitsuba() {
+        // A shape without a material is diffuse 0.5; an emitter without one is black (Mitsuba 3's
+        // `Shape::Shape`), so that it adds no reflected light.
+        let scene = load_scene_str(
+            "[camera]\nfov = 30\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n\
+             [[shapes]]\ntype = \"cube\"\n[[shapes]]\ntype = \"rectangle\"\nemission = 1\n",
+            Path::new("inline.toml"),
+            &SceneOverrides::default(),
+        )
+        .unwrap();
+        let reflectance = |shape: usize| match scene.materials[scene.geometry.shapes[shape].material as usize].kind {
+            MaterialKind::Diffuse { reflectance: ColorParam::Value(c) } => c,
+            ref other => panic!("{other:?}"),
+        };
+        assert_eq!(reflectance(0), Rgb::splat(0.5));
+        assert_eq!(reflectance(1), Rgb::ZERO);
+    }
 }

@@ -77,11 +77,9 @@ impl ImageTexture {
     }
 }
 
-/// A texture node.
+/// A texture node. (Constant values are not textures: parameters hold them directly.)
 #[derive(Clone, Debug)]
 pub enum Texture {
-    /// The same value everywhere.
-    Constant(Vec4),
     /// An image.
     Image(ImageTexture),
 }
@@ -91,7 +89,6 @@ impl Texture {
     #[inline]
     pub fn eval(&self, ctx: &TexCtx) -> Vec4 {
         match self {
-            Texture::Constant(v) => *v,
             Texture::Image(t) => t.eval(ctx),
         }
     }
@@ -104,7 +101,6 @@ impl Texture {
     /// Approximate memory held, in bytes.
     pub fn memory_bytes(&self) -> usize {
         match self {
-            Texture::Constant(_) => 0,
             Texture::Image(t) => t.mipmap.memory_bytes(),
         }
     }
