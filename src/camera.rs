@@ -24,6 +24,8 @@ pub struct PerspectiveCamera {
     position: Vec3,
     width: u32,
     height: u32,
+    /// The field of view as given, in degrees, and the axis it spans.
+    fov: (f32, FovAxis),
     /// tan(half field of view) along x and y.
     tan_half: Vec2,
     /// Scale of the ray differentials: max(1/8, 1/sqrt(spp)) (pbrt-v4), since the footprint of a
@@ -55,6 +57,7 @@ impl PerspectiveCamera {
             position: to_world.transform_point3(Vec3::ZERO),
             width,
             height,
+            fov: (fov_degrees, fov_axis),
             tan_half,
             differential_scale: (1.0 / (spp.max(1) as f32).sqrt()).max(0.125),
             min_direction_step: Vec2::ZERO,
@@ -89,6 +92,11 @@ impl PerspectiveCamera {
     /// Camera-to-world transform.
     pub fn to_world(&self) -> Mat4 {
         self.to_world
+    }
+
+    /// Field of view in degrees and the image axis it spans.
+    pub fn fov(&self) -> (f32, FovAxis) {
+        self.fov
     }
 
     /// Image size in pixels.

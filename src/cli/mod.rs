@@ -45,6 +45,10 @@ enum Command {
         /// Auxiliary outputs to add to an EXR, comma separated.
         #[arg(long, value_delimiter = ',')]
         aov: Vec<Aov>,
+        /// Add the per-pixel variance of one sample to an EXR (channels variance.R/G/B), as
+        /// `tessera diff --variance` takes it.
+        #[arg(long)]
+        variance: bool,
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
@@ -53,6 +57,41 @@ enum Command {
     Info {
         /// Scene file (TOML).
         scene: PathBuf,
+    },
+    /// Compare a rendered image with a reference: relMSE, MAE, mean FLIP, and Mitsuba's per-pixel
+    /// Z-test when the reference's variance is given. Exits 0 on pass, 1 on fail.
+    Diff {
+        /// The image under test (EXR).
+        test: PathBuf,
+        /// The reference image (EXR).
+        reference: PathBuf,
+        /// Per-pixel variance of one sample of the reference (EXR): enables the Z-test.
+        #[arg(long, requires = "spp")]
+        variance: Option<PathBuf>,
+        /// Samples per pixel of the test image (for the Z-test).
+        #[arg(long)]
+        spp: Option<u32>,
+        /// Fail when relMSE exceeds this.
+        #[arg(long)]
+        max_relmse: Option<f64>,
+        /// Fail when the mean FLIP exceeds this.
+        #[arg(long)]
+        max_flip: Option<f64>,
+        /// Write an error image (EXR): |test - reference| as RGB, the FLIP map, and with the Z-test
+        /// the smallest p-value of each pixel.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
+    /// Write a scene as Mitsuba 3 XML (meshes as OBJ, textures baked to EXR) to render it there.
+    ExportMitsuba {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Output folder (created; scene.xml, meshes/ and textures/ go in it).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Samples per pixel written into the exported scene (default: the scene's).
+        #[arg(long)]
+        spp: Option<u32>,
     },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
@@ -72,18 +111,30 @@ enum Command {
 /// Parse the command line and run it.
 pub fn run() -> Result<ExitCode> {
     match Cli::parse().command {
-        Command::Render { scene, output, spp, threads, seed, crop, aov, quiet } => {
+        Command::Render { scene, output, spp, threads, seed, crop, aov, variance, quiet } => {
             let overrides = SceneOverrides { spp, seed, ..Default::default() };
             let output = output.unwrap_or_else(|| default_output(&scene));
             tessera::image::OutputFormat::from_path(&output)?;
             let scene = load(&scene, &overrides, quiet)?;
             let crop = crop.map(|c| parse_crop(&c, &scene)).transpose()?;
-            render_to_file(&scene, &output, threads, crop, &aov, quiet)?;
+            render_to_file(&scene, &output, threads, crop, &aov, variance, quiet)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Info { scene } => {
             let scene = load(&scene, &SceneOverrides::default(), false)?;
             print_info(&scene);
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Diff { test, reference, variance, spp, max_relmse, max_flip, output } => {
+            diff(&test, &reference, variance.as_deref().zip(spp), max_relmse, max_flip, output.as_deref())
+        }
+        Command::ExportMitsuba { scene, output, spp } => {
+            let scene = load(&scene, &SceneOverrides { spp, ..Default::default() }, false)?;
+            let export = tessera::scene::export_mitsuba(&scene, &output)?;
+            for w in &export.warnings {
+                eprintln!("warning: {w}");
+            }
+            eprintln!("{}: wrote {} files to {}", scene.path.display(), export.files.len(), output.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Bench { runs, threads, scenes } => {
@@ -134,6 +185,7 @@ fn render_to_file(
     threads: Option<usize>,
     crop: Option<Crop>,
     aovs: &[Aov],
+    variance: bool,
     quiet: bool,
 ) -> Result<()> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -154,8 +206,11 @@ fn render_to_file(
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let extra: Vec<(&[&str], tessera::image::Bitmap)> =
+    let mut extra: Vec<(&[&str], tessera::image::Bitmap)> =
         aovs.iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();
+    if variance {
+        extra.push((&["variance.R", "variance.G", "variance.B"], film.variance()));
+    }
     if !extra.is_empty() && tessera::image::OutputFormat::from_path(output)? == tessera::image::OutputFormat::Png {
         eprintln!("warning: AOVs are written to EXR outputs only");
     }
@@ -174,6 +229,83 @@ fn render_to_file(
         );
     }
     Ok(())
+}
+
+fn diff(
+    test: &Path,
+    reference: &Path,
+    variance: Option<(&Path, u32)>,
+    max_relmse: Option<f64>,
+    max_flip: Option<f64>,
+    output: Option<&Path>,
+) -> Result<ExitCode> {
+    use tessera::image::{ColorSpace, compare, read_bitmap};
+    if variance.is_none() && max_relmse.is_none() && max_flip.is_none() {
+        return Err(Error::param(
+            "diff",
+            "give a criterion: --variance with --spp (Z-test), --max-relmse or --max-flip",
+        ));
+    }
+    let t = read_bitmap(test, ColorSpace::Linear)?;
+    let r = read_bitmap(reference, ColorSpace::Linear)?;
+    let m = compare::image_metrics(&t, &r)?;
+    println!("relmse     {:.6e}", m.relmse);
+    println!("mae        {:.6e}", m.mae);
+    println!("flip       {:.6}  (mean LDR-FLIP)", m.mean_flip);
+    println!("mean       test {:?}, reference {:?}", m.mean_test.map(|v| v as f32), m.mean_reference.map(|v| v as f32));
+    let mut failures = Vec::new();
+    if let Some(limit) = max_relmse.filter(|l| m.relmse > *l) {
+        failures.push(format!("relMSE {:.4e} > {limit:e}", m.relmse));
+    }
+    if let Some(limit) = max_flip.filter(|l| m.mean_flip > *l) {
+        failures.push(format!("mean FLIP {:.4} > {limit}", m.mean_flip));
+    }
+    let z = match variance {
+        Some((path, spp)) => {
+            let v = read_bitmap(path, ColorSpace::Linear)?;
+            let z = compare::z_test(&t, spp, &r, &v)?;
+            println!(
+                "z-test     {:.4}% of pixels accepted (need {}%), alpha {:.3e}, min p {:.3e}",
+                100.0 * z.accepted_fraction,
+                100.0 * compare::PASS_FRACTION,
+                z.alpha,
+                z.min_p
+            );
+            println!("mean z     {:?}", z.mean_z.map(|v| (v * 100.0).round() / 100.0));
+            if !z.pixels_pass() {
+                failures.push(format!("only {:.3}% of pixels pass the Z-test", 100.0 * z.accepted_fraction));
+            }
+            if !z.mean_passes(5.0) {
+                failures.push(format!("the image mean is off by {:?} standard errors", z.mean_z.map(|v| v as f32)));
+            }
+            Some(z)
+        }
+        None => None,
+    };
+    if let Some(out) = output {
+        let flip = compare::flip_map(&t, &r)?;
+        let mut err = tessera::image::Bitmap::new(t.width, t.height, 3);
+        for (i, e) in err.data.iter_mut().enumerate() {
+            let (px, c) = (i / 3, i % 3);
+            *e = (t.pixel(px % t.width, px / t.width)[c] - r.pixel(px % r.width, px / r.width)[c]).abs();
+        }
+        let mut extra: Vec<(&[&str], tessera::image::Bitmap)> = vec![(&["flip.Y"], flip)];
+        if let Some(z) = &z {
+            let mut min_p = tessera::image::Bitmap::new(t.width, t.height, 1);
+            for (i, v) in min_p.data.iter_mut().enumerate() {
+                *v = z.p_values.data[3 * i..3 * i + 3].iter().copied().fold(1.0, f32::min);
+            }
+            extra.push((&["pvalue.Y"], min_p));
+        }
+        write_image(out, &err, &extra)?;
+    }
+    if failures.is_empty() {
+        println!("PASS");
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!("FAIL: {}", failures.join("; "));
+        Ok(ExitCode::FAILURE)
+    }
 }
 
 fn print_info(scene: &Scene) {

@@ -3,6 +3,7 @@
 //! accumulates samples.
 
 mod bitmap;
+pub mod compare;
 mod film;
 mod io;
 

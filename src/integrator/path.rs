@@ -117,10 +117,14 @@ impl<'a> PathTracer<'a> {
             let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy };
             let material = &scene.materials[shape.material as usize];
             let bsdf = material.bsdf(&scene.textures, &ctx);
-            let mut frame = material.shading_frame(&scene.textures, &ctx, si.frame);
-            if material.two_sided && frame.n.dot(si.wo) < 0.0 {
-                frame = Frame { s: frame.s, t: -frame.t, n: -frame.n };
+            // Two-sided materials see the back as the front: mirror the local z axis to the
+            // viewer's side (Mitsuba's `twosided`), before any normal map perturbs the frame.
+            let mut base = si.frame;
+            if material.two_sided && base.n.dot(si.wo) < 0.0 {
+                base = Frame { n: -base.n, ..base };
             }
+            let shading = material.shading(&scene.textures, &ctx, base);
+            let frame = shading.frame;
             let wo = frame.to_local(si.wo);
             if depth == 0 {
                 *first_hit = Some(FirstHit {
@@ -137,7 +141,7 @@ impl<'a> PathTracer<'a> {
             if !bsdf.is_delta() {
                 if let Some(ls) = lights.sample(si.p, u_light, u_light2) {
                     let wi = frame.to_local(ls.wi);
-                    let f = bsdf.eval(wo, wi);
+                    let f = bsdf.eval(wo, wi) * shading.light_factor(ls.wi);
                     if f != Rgb::ZERO && ls.pdf > 0.0 {
                         let shadow = match ls.point {
                             Some(q) => si.spawn_ray_to(q),
@@ -157,9 +161,13 @@ impl<'a> PathTracer<'a> {
             let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
                 break;
             };
-            throughput *= bs.weight;
-            eta_scale *= bs.eta;
             let wi = frame.to_world(bs.wi);
+            let factor = shading.light_factor(wi);
+            if factor == 0.0 {
+                break;
+            }
+            throughput *= bs.weight * factor;
+            eta_scale *= bs.eta;
             prev = PreviousVertex { p: si.p, pdf: bs.pdf, delta: bs.delta };
             ray = si.spawn_ray(wi);
             depth += 1;

@@ -23,11 +23,21 @@ pub enum Environment {
 }
 
 /// An equirectangular environment map with its sampling distribution.
+///
+/// The lookup interpolates bilinearly between texel centres, so the radiance is exactly bilinear
+/// on the cells between four neighbouring texel centres: columns x = u W - 0.5 in [i, i + 1]
+/// (wrapping), rows y = v (H - 1) in [j, j + 1]. Sampling follows that: a cell is chosen with
+/// probability proportional to the integral of luminance times sin(theta) over it (the mean of
+/// its corners), then a point inside it with density proportional to the bilinear interpolation
+/// of its corners (Mitsuba 3's `envmap` likewise samples the bilinear interpolant). The density
+/// thus follows the radiance closely, even next to a one-texel sun.
 #[derive(Clone, Debug)]
 pub struct EnvironmentMap {
     image: Bitmap,
     scale: f32,
-    /// Over (u, v) cells of the image's resolution, proportional to luminance times sin(theta).
+    /// Luminance times sin(theta) at each texel centre, row-major (the cells' corner weights).
+    weights: Vec<f32>,
+    /// Over the W x (H - 1) cells.
     distribution: Distribution2D,
 }
 
@@ -48,30 +58,37 @@ fn uv_to_direction(uv: Vec2) -> Vec3 {
 }
 
 impl EnvironmentMap {
-    /// A map from an RGB(A) image, its radiance multiplied by `scale`.
+    /// A map from an RGB(A) image (at least 2 rows), its radiance multiplied by `scale`.
     pub fn new(image: Bitmap, scale: f32) -> Self {
-        let (w, h) = (image.width, image.height);
-        let mut weights = vec![0.0f32; w * h];
-        let mut map = EnvironmentMap { image, scale, distribution: Distribution2D::new(&[1.0], 1, 1) };
-        for j in 0..h {
-            let v = (j as f32 + 0.5) / h as f32;
-            let sin_theta = (v * PI).sin();
-            for i in 0..w {
-                // Luminance at the cell centre and its four corners: cells bridging a bright
-                // texel keep a share of the samples.
-                let corners = [(0.5, 0.5), (0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)];
-                let lum = corners
-                    .iter()
-                    .map(|(du, dv)| {
-                        let uv = Vec2::new((i as f32 + du) / w as f32, ((j as f32 + dv) / h as f32).min(1.0));
-                        luminance(map.lookup_uv(uv))
-                    })
-                    .fold(0.0f32, f32::max);
-                weights[j * w + i] = lum * sin_theta;
-            }
-        }
-        map.distribution = Distribution2D::new(&weights, w, h);
-        map
+        let (w, h) = (image.width, image.height.max(2));
+        let weights: Vec<f32> = (0..w * h)
+            .map(|k| {
+                let (x, y) = (k % w, (k / w).min(image.height - 1));
+                let sin_theta = (PI * y as f32 / (h - 1) as f32).sin().max(0.0);
+                luminance(image.pixel(x, y).truncate()).max(0.0) * sin_theta
+            })
+            .collect();
+        let cells: Vec<f32> = (0..w * (h - 1))
+            .map(|k| {
+                let corners = Self::corners(&weights, w, k % w, k / w);
+                corners.iter().sum::<f32>() * 0.25
+            })
+            .collect();
+        let distribution = Distribution2D::new(&cells, w, h - 1);
+        EnvironmentMap { image, scale, weights, distribution }
+    }
+
+    /// Corner weights of cell (i, j): texel centres (i, j), (i + 1, j), (i, j + 1), (i + 1, j + 1),
+    /// columns wrapping.
+    #[inline]
+    fn corners(weights: &[f32], w: usize, i: usize, j: usize) -> [f32; 4] {
+        let i1 = (i + 1) % w;
+        [weights[j * w + i], weights[j * w + i1], weights[(j + 1) * w + i], weights[(j + 1) * w + i1]]
+    }
+
+    /// The image (negative values already clamped to 0) and the radiance scale.
+    pub fn image(&self) -> (&Bitmap, f32) {
+        (&self.image, self.scale)
     }
 
     /// Bilinear radiance at (u, v).
@@ -90,6 +107,29 @@ impl EnvironmentMap {
         let bottom = px(c0, r1) * (1.0 - fx) + px(c1, r1) * fx;
         (top * (1.0 - fy) + bottom * fy) * self.scale
     }
+
+    /// Sample (u, v) and its density over the unit square.
+    fn sample_uv(&self, u: Vec2) -> Option<(Vec2, f32)> {
+        let (w, h) = (self.image.width, self.image.height.max(2));
+        let (i, j, pmf, remapped) = self.distribution.sample_cell(u);
+        let corners = Self::corners(&self.weights, w, i, j);
+        let p = warp::square_to_bilinear(remapped, corners);
+        let uv = Vec2::new(((i as f32 + 0.5 + p.x) / w as f32).fract(), (j as f32 + p.y) / (h - 1) as f32);
+        let cell_area = 1.0 / (w * (h - 1)) as f32;
+        let pdf = pmf * warp::bilinear_pdf(p, corners) / cell_area;
+        (pdf > 0.0).then_some((uv, pdf))
+    }
+
+    /// Density over the unit square of [`EnvironmentMap::sample_uv`] at (u, v).
+    fn pdf_uv(&self, uv: Vec2) -> f32 {
+        let (w, h) = (self.image.width, self.image.height.max(2));
+        let x = (uv.x * w as f32 - 0.5).rem_euclid(w as f32);
+        let y = (uv.y * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
+        let (i, j) = ((x as usize).min(w - 1), (y as usize).min(h - 2));
+        let p = Vec2::new(x - i as f32, y - j as f32);
+        let cell_area = 1.0 / (w * (h - 1)) as f32;
+        self.distribution.cell_pmf(i, j) * warp::bilinear_pdf(p, Self::corners(&self.weights, w, i, j)) / cell_area
+    }
 }
 
 impl Environment {
@@ -106,10 +146,7 @@ impl Environment {
         let (wi, pdf) = match self {
             Environment::Constant(_) => (warp::square_to_uniform_sphere(u), warp::UNIFORM_SPHERE_PDF),
             Environment::Map(m) => {
-                let (uv, pdf_uv) = m.distribution.sample(u);
-                if pdf_uv <= 0.0 {
-                    return None;
-                }
+                let (uv, _) = m.sample_uv(u)?;
                 let wi = uv_to_direction(uv);
                 // The density as `pdf` computes it from the direction, so that MIS weights use one
                 // function (a sample on a cell edge may round into the neighbouring cell).
@@ -132,7 +169,7 @@ impl Environment {
                 if sin_theta == 0.0 {
                     return 0.0;
                 }
-                m.distribution.pdf(direction_to_uv(d)) / (2.0 * PI * PI * sin_theta)
+                m.pdf_uv(direction_to_uv(d)) / (2.0 * PI * PI * sin_theta)
             }
         }
     }

@@ -1,5 +1,5 @@
 //! Piecewise-constant distributions for sampling by tabulated weights (pbrt-v4
-//! `PiecewiseConstant1D/2D`): triangles of an emitter by area, texels of an environment map.
+//! `PiecewiseConstant1D/2D`): triangles of an emitter by area, cells of an environment map.
 
 use glam::Vec2;
 
@@ -113,20 +113,17 @@ impl Distribution2D {
         Distribution2D { rows, marginal: Distribution1D::new(&row_mass) }
     }
 
-    /// A point in [0, 1)^2 (x along the row, y across rows) and its density.
-    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
-        let (y, pdf_y, row) = self.marginal.sample_continuous(u.y);
-        let (x, pdf_x, _) = self.rows[row].sample_continuous(u.x);
-        (Vec2::new(x, y), pdf_x * pdf_y)
+    /// Choose a cell with probability proportional to its weight: (column, row), its
+    /// probability, and the uniform numbers rescaled to [0, 1) within the cell.
+    pub fn sample_cell(&self, u: Vec2) -> (usize, usize, f32, Vec2) {
+        let row = self.marginal.sample_discrete(u.y);
+        let col = self.rows[row.index].sample_discrete(u.x);
+        (col.index, row.index, col.pmf * row.pmf, Vec2::new(col.u_remapped, row.u_remapped))
     }
 
-    /// Density at a point of [0, 1]^2.
-    pub fn pdf(&self, p: Vec2) -> f32 {
-        let h = self.marginal.len();
-        let w = self.rows[0].len();
-        let row = ((p.y * h as f32) as usize).min(h - 1);
-        let col = ((p.x * w as f32) as usize).min(w - 1);
-        self.marginal.pdf_cell(row) * self.rows[row].pdf_cell(col)
+    /// Probability of cell (column, row).
+    pub fn cell_pmf(&self, col: usize, row: usize) -> f32 {
+        self.marginal.pmf(row) * self.rows[row].pmf(col)
     }
 }
 
@@ -152,16 +149,23 @@ mod tests {
     }
 
     #[test]
-    fn distribution2d_pdf_matches_sample_density() {
+    fn distribution2d_cells_follow_weights() {
         let weights = [1.0, 2.0, 0.0, 5.0, 0.5, 0.5];
         let d = Distribution2D::new(&weights, 3, 2);
         let total: f32 = weights.iter().sum();
-        for u in [Vec2::new(0.1, 0.2), Vec2::new(0.9, 0.7), Vec2::new(0.5, 0.99)] {
-            let (p, pdf) = d.sample(u);
-            assert!((d.pdf(p) - pdf).abs() < 1e-5);
-            let cell = (p.y * 2.0) as usize * 3 + (p.x * 3.0) as usize;
-            // Density = weight / (total / cells).
-            assert!((pdf - weights[cell] / (total / 6.0)).abs() < 1e-5);
+        let mut counts = [0usize; 6];
+        let n = 60_000;
+        for i in 0..n {
+            let u = Vec2::new(((i * 7919) % n) as f32 / n as f32, (i as f32 + 0.5) / n as f32);
+            let (col, row, pmf, remapped) = d.sample_cell(u);
+            assert!((pmf - weights[row * 3 + col] / total).abs() < 1e-6);
+            assert!((d.cell_pmf(col, row) - pmf).abs() < 1e-7);
+            assert!((0.0..1.0).contains(&remapped.x) && (0.0..1.0).contains(&remapped.y));
+            counts[row * 3 + col] += 1;
+        }
+        assert_eq!(counts[2], 0, "a zero-weight cell is never chosen");
+        for (c, w) in counts.iter().zip(weights) {
+            assert!((*c as f32 / n as f32 - w / total).abs() < 0.01, "{counts:?}");
         }
     }
 }

@@ -50,6 +50,38 @@ pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
     Vec2::new(1.0 - t, t * u.y)
 }
 
+/// Sample x in [0, 1] with density proportional to the linear function from `a` (at 0) to `b`
+/// (at 1), both non-negative and not both zero: invert the quadratic CDF in its stable form.
+#[inline]
+pub fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
+    if u == 0.0 && a == 0.0 {
+        return 0.0;
+    }
+    let x = u * (a + b) / (a + (a * a + u * (b * b - a * a)).max(0.0).sqrt());
+    x.min(1.0 - f32::EPSILON)
+}
+
+/// Sample a point of [0, 1]^2 with density proportional to the bilinear interpolation of corner
+/// weights `w` = [w(0,0), w(1,0), w(0,1), w(1,1)]: y from the marginal, then x given y.
+#[inline]
+pub fn square_to_bilinear(u: Vec2, w: [f32; 4]) -> Vec2 {
+    let y = sample_linear(u.y, w[0] + w[1], w[2] + w[3]);
+    let x = sample_linear(u.x, w[0] + (w[2] - w[0]) * y, w[1] + (w[3] - w[1]) * y);
+    Vec2::new(x, y)
+}
+
+/// Density of [`square_to_bilinear`] at `p` (uniform when all weights are zero).
+#[inline]
+pub fn bilinear_pdf(p: Vec2, w: [f32; 4]) -> f32 {
+    let sum = w[0] + w[1] + w[2] + w[3];
+    if sum == 0.0 {
+        return 1.0;
+    }
+    let value =
+        (1.0 - p.x) * (1.0 - p.y) * w[0] + p.x * (1.0 - p.y) * w[1] + (1.0 - p.x) * p.y * w[2] + p.x * p.y * w[3];
+    4.0 * value / sum
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -88,6 +120,33 @@ mod tests {
         }
         let mean = sum / (n * n) as f32;
         assert!((mean - 2.0 / 3.0).abs() < 1e-3, "{mean}");
+    }
+
+    #[test]
+    fn bilinear_warp_inverts_its_cdf() {
+        // The fraction of samples below (x0, y0) equals the integral of the density there.
+        let w = [0.2, 3.0, 1.0, 0.0];
+        let n = 300;
+        let (x0, y0) = (0.4f32, 0.7f32);
+        let mut below = 0;
+        for i in 0..n {
+            for j in 0..n {
+                let p = square_to_bilinear(Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32), w);
+                assert!((0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y));
+                below += usize::from(p.x < x0 && p.y < y0);
+            }
+        }
+        // Integral of the density over [0, x0] x [0, y0], by a fine midpoint rule.
+        let m = 400;
+        let mut integral = 0.0;
+        for a in 0..m {
+            for b in 0..m {
+                let p = Vec2::new((a as f32 + 0.5) / m as f32 * x0, (b as f32 + 0.5) / m as f32 * y0);
+                integral += bilinear_pdf(p, w) * x0 * y0 / (m * m) as f32;
+            }
+        }
+        let fraction = below as f32 / (n * n) as f32;
+        assert!((fraction - integral).abs() < 3e-3, "{fraction} vs {integral}");
     }
 
     #[test]

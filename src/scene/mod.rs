@@ -4,8 +4,10 @@
 pub mod desc;
 mod gltf;
 mod load;
+mod mitsuba;
 
 pub use load::{SceneOverrides, load_scene, load_scene_str};
+pub use mitsuba::{MitsubaExport, export_mitsuba};
 
 use crate::accel::Accel;
 use crate::camera::PerspectiveCamera;

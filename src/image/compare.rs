@@ -1,0 +1,211 @@
+//! Image comparison: the error metrics of `tessera diff` and of the render tests.
+//!
+//! - relMSE = mean((t - r)^2 / (r^2 + 0.01)) over all values, and MAE = mean |t - r|;
+//! - mean FLIP: NVIDIA's FLIP (Andersson et al. 2020, via the `nv-flip` crate) between the two
+//!   images tone-mapped to 8-bit sRGB (exposure 1, clamped: LDR-FLIP) at 67 pixels per degree;
+//! - the per-pixel Z-test of Mitsuba 3's `src/render/tests/test_renders.py`: with the
+//!   reference's per-sample variance v (floored at 1e-4) and the test image's sample count n,
+//!   z = |t - r| sqrt(n / v), p = 2 (1 - Phi(z)); a value is accepted when p exceeds the Sidak
+//!   correction of 0.01 over the pixel count, and the image passes when accepted values / 3 are at
+//!   least 99.75% of the pixels. The image mean is checked too: a bias too small for any one pixel
+//!   shows there (its z is computed from the same variances).
+
+use super::Bitmap;
+use crate::color::linear_to_srgb;
+use crate::error::{Error, Result};
+
+/// Sample variance below which the Z-test does not trust the reference (Mitsuba's floor).
+pub const MIN_VARIANCE: f64 = 1e-4;
+/// Overall significance level of the per-pixel Z-test (Mitsuba's).
+pub const SIGNIFICANCE: f64 = 0.01;
+/// Fraction of pixels that must pass for the image to pass (Mitsuba's).
+pub const PASS_FRACTION: f64 = 0.9975;
+
+/// Differences between a test image and a reference.
+#[derive(Clone, Debug)]
+pub struct ImageMetrics {
+    /// mean((t - r)^2 / (r^2 + 0.01)).
+    pub relmse: f64,
+    /// mean |t - r|.
+    pub mae: f64,
+    /// Mean LDR-FLIP error in [0, 1].
+    pub mean_flip: f64,
+    /// Mean of each channel of the test image.
+    pub mean_test: [f64; 3],
+    /// Mean of each channel of the reference.
+    pub mean_reference: [f64; 3],
+}
+
+/// Outcome of the per-pixel Z-test.
+#[derive(Clone, Debug)]
+pub struct ZTest {
+    /// Per-value significance after the Sidak correction.
+    pub alpha: f64,
+    /// Fraction of pixels accepted (accepted values / 3 / pixels).
+    pub accepted_fraction: f64,
+    /// Smallest p-value.
+    pub min_p: f64,
+    /// z of each channel's image mean against the reference's.
+    pub mean_z: [f64; 3],
+    /// Per-pixel p-values (RGB).
+    pub p_values: Bitmap,
+}
+
+impl ZTest {
+    /// Mitsuba's criterion: at least 99.75% of the pixels accepted.
+    pub fn pixels_pass(&self) -> bool {
+        self.accepted_fraction >= PASS_FRACTION
+    }
+
+    /// True when every channel's image mean lies within `sigmas` standard errors.
+    pub fn mean_passes(&self, sigmas: f64) -> bool {
+        self.mean_z.iter().all(|z| z.abs() <= sigmas)
+    }
+}
+
+fn check_sizes(a: &Bitmap, b: &Bitmap, what: &str) -> Result<()> {
+    if (a.width, a.height) != (b.width, b.height) || a.channels < 3 || b.channels < 3 {
+        return Err(Error::param(
+            what,
+            format!(
+                "images differ in size or lack RGB: {}x{}x{} vs {}x{}x{}",
+                a.width, a.height, a.channels, b.width, b.height, b.channels
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// RGB of pixel i as f64.
+fn rgb(b: &Bitmap, i: usize) -> [f64; 3] {
+    let p = b.pixel(i % b.width, i / b.width);
+    [p.x as f64, p.y as f64, p.z as f64]
+}
+
+fn to_srgb8(b: &Bitmap) -> Vec<u8> {
+    (0..b.width * b.height)
+        .flat_map(|i| rgb(b, i).map(|v| (linear_to_srgb((v as f32).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
+        .collect()
+}
+
+/// The per-pixel LDR-FLIP error map (one channel) of `test` against `reference`.
+pub fn flip_map(test: &Bitmap, reference: &Bitmap) -> Result<Bitmap> {
+    check_sizes(test, reference, "flip")?;
+    let (w, h) = (test.width as u32, test.height as u32);
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, &to_srgb8(reference));
+    let t = nv_flip::FlipImageRgb8::with_data(w, h, &to_srgb8(test));
+    let map = nv_flip::flip(r, t, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    Ok(Bitmap { width: test.width, height: test.height, channels: 1, data: map.to_vec() })
+}
+
+/// relMSE, MAE, mean FLIP and channel means of `test` against `reference`.
+pub fn image_metrics(test: &Bitmap, reference: &Bitmap) -> Result<ImageMetrics> {
+    check_sizes(test, reference, "metrics")?;
+    let n = test.width * test.height;
+    let (mut relmse, mut mae) = (0.0, 0.0);
+    let (mut mean_test, mut mean_reference) = ([0.0; 3], [0.0; 3]);
+    for i in 0..n {
+        let (t, r) = (rgb(test, i), rgb(reference, i));
+        for c in 0..3 {
+            relmse += (t[c] - r[c]).powi(2) / (r[c] * r[c] + 0.01);
+            mae += (t[c] - r[c]).abs();
+            mean_test[c] += t[c];
+            mean_reference[c] += r[c];
+        }
+    }
+    let values = (3 * n) as f64;
+    let flip = flip_map(test, reference)?;
+    let mean_flip = flip.data.iter().map(|&v| v as f64).sum::<f64>() / n as f64;
+    Ok(ImageMetrics {
+        relmse: relmse / values,
+        mae: mae / values,
+        mean_flip,
+        mean_test: mean_test.map(|m| m / n as f64),
+        mean_reference: mean_reference.map(|m| m / n as f64),
+    })
+}
+
+/// The Z-test of `test` (rendered with `spp` samples per pixel) against `reference` and its
+/// per-sample `variance`.
+pub fn z_test(test: &Bitmap, spp: u32, reference: &Bitmap, variance: &Bitmap) -> Result<ZTest> {
+    check_sizes(test, reference, "z-test")?;
+    check_sizes(variance, reference, "variance")?;
+    let n = test.width * test.height;
+    let alpha = 1.0 - (1.0 - SIGNIFICANCE).powf(1.0 / n as f64);
+    let mut p_values = Bitmap::new(test.width, test.height, 3);
+    let (mut accepted, mut min_p) = (0usize, 1.0f64);
+    let (mut sum_diff, mut sum_var) = ([0.0f64; 3], [0.0f64; 3]);
+    for i in 0..n {
+        let (t, r, v) = (rgb(test, i), rgb(reference, i), rgb(variance, i));
+        for c in 0..3 {
+            let var = v[c].max(MIN_VARIANCE);
+            let z = (t[c] - r[c]).abs() * (spp as f64 / var).sqrt();
+            // 2 (1 - Phi(z)) = erfc(z / sqrt 2).
+            let p = libm::erfc(z / std::f64::consts::SQRT_2);
+            p_values.data[3 * i + c] = p as f32;
+            accepted += usize::from(p > alpha);
+            min_p = min_p.min(p);
+            sum_diff[c] += t[c] - r[c];
+            sum_var[c] += var / spp as f64;
+        }
+    }
+    let mean_z = std::array::from_fn(|c| sum_diff[c] / sum_var[c].sqrt());
+    Ok(ZTest { alpha, accepted_fraction: accepted as f64 / 3.0 / n as f64, min_p, mean_z, p_values })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(w: usize, h: usize, f: impl Fn(usize) -> f32) -> Bitmap {
+        Bitmap { width: w, height: h, channels: 3, data: (0..w * h * 3).map(f).collect() }
+    }
+
+    #[test]
+    fn identical_images_have_zero_error() {
+        let a = image(16, 8, |i| (i % 7) as f32 * 0.1);
+        let m = image_metrics(&a, &a).unwrap();
+        assert_eq!((m.relmse, m.mae), (0.0, 0.0));
+        assert!(m.mean_flip < 1e-6, "{}", m.mean_flip);
+    }
+
+    #[test]
+    fn relmse_and_mae_match_their_definitions() {
+        let r = image(4, 4, |_| 0.5);
+        let t = image(4, 4, |_| 0.6);
+        let m = image_metrics(&t, &r).unwrap();
+        assert!((m.mae - 0.1).abs() < 1e-6);
+        assert!((m.relmse - 0.01 / (0.25 + 0.01)).abs() < 1e-6);
+        // A visible difference is a visible FLIP error.
+        let black = image(32, 32, |_| 0.0);
+        let white = image(32, 32, |_| 1.0);
+        assert!(image_metrics(&black, &white).unwrap().mean_flip > 0.5);
+    }
+
+    #[test]
+    fn z_test_accepts_noise_and_rejects_bias() {
+        // Test images drawn around the reference with the variance of a mean of 64 samples.
+        let (w, h, spp) = (64, 64, 64u32);
+        let reference = image(w, h, |i| 0.2 + 0.001 * (i % 97) as f32);
+        let variance = image(w, h, |_| 0.04);
+        let sigma = (0.04f64 / spp as f64).sqrt();
+        // A deterministic normal-ish deviate from a hash: the sum of 4 uniforms, scaled.
+        let noise = |i: usize, salt: u64| {
+            let u = |k: u64| {
+                let mut s = crate::sampling::Sampler::new(salt, i as u64, k as u32);
+                s.next_1d() as f64
+            };
+            ((u(0) + u(1) + u(2) + u(3)) - 2.0) * (3.0f64).sqrt()
+        };
+        let noisy = image(w, h, |i| (reference.data[i] as f64 + sigma * noise(i, 1)) as f32);
+        let z = z_test(&noisy, spp, &reference, &variance).unwrap();
+        assert!(z.pixels_pass() && z.mean_passes(5.0), "{:?} {:?}", z.accepted_fraction, z.mean_z);
+        // Shift every pixel by 1% of the value: no single pixel is rejected, the mean is.
+        let biased = image(w, h, |i| noisy.data[i] * 1.01);
+        let zb = z_test(&biased, spp, &reference, &variance).unwrap();
+        assert!(!zb.mean_passes(5.0), "{:?}", zb.mean_z);
+        // A hot region fails the per-pixel test.
+        let hot = image(w, h, |i| if i < w * h * 3 / 100 { noisy.data[i] + 1.0 } else { noisy.data[i] });
+        assert!(!z_test(&hot, spp, &reference, &variance).unwrap().pixels_pass());
+    }
+}

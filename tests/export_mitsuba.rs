@@ -1,0 +1,166 @@
+//! The Mitsuba 3 export: its XML says what tessera renders. (The golden tests check the whole
+//! chain: Mitsuba renders these exports and tessera must agree with the images.)
+
+mod common;
+
+use glam::{Mat4, Vec3, Vec4};
+use tessera::image::{ColorSpace, read_bitmap};
+use tessera::scene::{SceneOverrides, export_mitsuba, load_scene};
+
+fn export(scene_toml: &str, files: &[(&str, &[u8])]) -> (tempfile::TempDir, std::path::PathBuf, String) {
+    let dir = common::scene_dir(scene_toml, files);
+    let scene = common::load(dir.path()).unwrap_or_else(|e| panic!("{e}"));
+    let out = dir.path().join("mitsuba");
+    export_mitsuba(&scene, &out).unwrap_or_else(|e| panic!("{e}"));
+    let xml = std::fs::read_to_string(out.join("scene.xml")).unwrap();
+    (dir, out, xml)
+}
+
+fn attr<'a>(node: roxmltree::Node<'a, 'a>, name: &str) -> Option<&'a str> {
+    node.children().find(|c| c.attribute("name") == Some(name)).and_then(|c| c.attribute("value"))
+}
+
+#[test]
+fn brushed_metal_exports_as_mitsuba_scene_a() {
+    let path = common::repo().join("scenes/golden/brushed_metal.toml");
+    let scene = load_scene(&path, &SceneOverrides::default()).unwrap();
+    let out = tempfile::tempdir().unwrap();
+    export_mitsuba(&scene, out.path()).unwrap();
+    let xml = std::fs::read_to_string(out.path().join("scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&xml).expect("well-formed XML");
+    let root = doc.root_element();
+    let integrator = root.children().find(|n| n.has_tag_name("integrator")).unwrap();
+    assert_eq!(integrator.attribute("type"), Some("path"));
+    assert_eq!(attr(integrator, "max_depth"), Some("8"));
+    assert_eq!(attr(integrator, "rr_depth"), Some("5"));
+
+    let sensor = root.children().find(|n| n.has_tag_name("sensor")).unwrap();
+    assert_eq!((attr(sensor, "fov"), attr(sensor, "fov_axis")), (Some("40"), Some("x")));
+    let matrix: Vec<f32> = sensor
+        .descendants()
+        .find(|n| n.has_tag_name("matrix"))
+        .and_then(|n| n.attribute("value"))
+        .unwrap()
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let m = Mat4::from_cols_array(&matrix.try_into().unwrap()).transpose();
+    // Mitsuba's camera looks down its +z, with +x to the left of the image.
+    let forward = m.transform_vector3(Vec3::Z).normalize();
+    let expected = (Vec3::new(0.0, -0.3, 0.0) - Vec3::new(0.0, 2.0, 4.6)).normalize();
+    assert!(forward.distance(expected) < 1e-5, "{forward} vs {expected}");
+    assert!(m.transform_vector3(Vec3::X).distance(-Vec3::X) < 1e-5, "image left is world -x");
+    assert!((m * Vec4::W).truncate().distance(Vec3::new(0.0, 2.0, 4.6)) < 1e-5);
+    let film = sensor.descendants().find(|n| n.has_tag_name("film")).unwrap();
+    assert_eq!((attr(film, "width"), attr(film, "height")), (Some("128"), Some("128")));
+    assert!(film.children().any(|n| n.has_tag_name("rfilter") && n.attribute("type") == Some("box")));
+
+    let metal = root.children().find(|n| n.attribute("type") == Some("roughconductor")).expect("roughconductor");
+    assert_eq!(attr(metal, "distribution"), Some("ggx"));
+    assert_eq!((attr(metal, "alpha_u"), attr(metal, "alpha_v")), (Some("0.05"), Some("0.3")));
+    assert_eq!(attr(metal, "eta"), Some("1.6575, 0.880405, 0.521244"));
+    let shapes: Vec<_> = root.children().filter(|n| n.has_tag_name("shape")).collect();
+    assert_eq!(shapes.len(), 3);
+    let emitters: Vec<_> = shapes.iter().filter_map(|s| s.children().find(|n| n.has_tag_name("emitter"))).collect();
+    assert_eq!(emitters.len(), 1);
+    assert_eq!(attr(emitters[0], "radiance"), Some("30, 30, 30"));
+    // The emitter's material is black (Mitsuba's default for emitters), the others are not.
+    let env = root.children().find(|n| n.has_tag_name("emitter")).unwrap();
+    assert_eq!((env.attribute("type"), attr(env, "radiance")), (Some("constant"), Some("0.25, 0.3, 0.4")));
+
+    // Each exported mesh reloads as exactly the scene's geometry, triangle by triangle (the OBJ
+    // loader numbers vertices in order of first use, so compare corners, not vertex arrays).
+    let g = &scene.geometry;
+    for (i, shape) in g.shapes.iter().enumerate() {
+        let mesh = tessera::geometry::obj::load_obj(&out.path().join(format!("meshes/shape{i}.obj"))).unwrap();
+        let triangles: Vec<usize> = (0..g.triangles.len()).filter(|&t| g.triangle_shape[t] as usize == i).collect();
+        assert_eq!(mesh.triangle_count(), triangles.len(), "shape {i}");
+        for (k, &t) in triangles.iter().enumerate() {
+            let exported = mesh.indices[k];
+            let original = g.triangle_vertices(t);
+            for c in 0..3 {
+                let v = exported[c] as usize;
+                assert!(mesh.positions[v] == original.p[c], "shape {i} triangle {k} corner {c}: position differs");
+                if let (Some(uvs), Some(orig)) = (&mesh.uvs, original.uv) {
+                    assert!(uvs[v] == orig[c], "shape {i} triangle {k} corner {c}: uv differs");
+                }
+            }
+        }
+        assert_eq!(mesh.uvs.is_some(), shape.has_uvs);
+        assert_eq!(mesh.normals.is_some(), shape.has_normals);
+    }
+}
+
+#[test]
+fn exported_texture_lookups_match_tessera() {
+    // A 4 x 2 image; a colour use, and a scalar use of its green channel scaled by 0.5, with a
+    // uv scale and offset.
+    let img = image::RgbImage::from_fn(4, 2, |x, y| image::Rgb([(x * 60) as u8, (y * 200 + 10) as u8, 100]));
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+    let toml = "[camera]\nfov = 30\neye = [0, 0, 4]\ntarget = [0, 0, 0]\n\
+        [textures.t]\ntype = \"image\"\nfilename = \"t.png\"\nscale = [3, 2]\noffset = [0.1, 0.25]\n\
+        [materials.m]\ntype = \"conductor\"\nalpha_u = { texture = \"t\", channel = \"g\", scale = 0.5 }\nalpha_v = 0.2\nspecular_reflectance = \"t\"\n\
+        [[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\n";
+    let (_dir, out, xml) = export(toml, &[("t.png", &png)]);
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let texture = |name: &str| {
+        doc.descendants()
+            .find(|n| n.has_tag_name("texture") && n.attribute("name") == Some(name))
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    // The scalar bake: 0.5 * green, as tessera reads it (linear for a scalar use).
+    let alpha = texture("alpha_u");
+    let file = attr(alpha, "filename").unwrap();
+    let baked = read_bitmap(&out.join(file), ColorSpace::Linear).unwrap();
+    assert_eq!((baked.width, baked.height, baked.channels), (4, 2, 1));
+    for y in 0..2 {
+        for x in 0..4 {
+            let expected = 0.5 * (y * 200 + 10) as f32 / 255.0;
+            assert!((baked.values(x, y)[0] - expected).abs() < 1e-6);
+        }
+    }
+    // The colour bake is sRGB-decoded.
+    let colour =
+        read_bitmap(&out.join(attr(texture("specular_reflectance"), "filename").unwrap()), ColorSpace::Linear).unwrap();
+    assert!((colour.values(1, 0)[0] - tessera::color::srgb_to_linear(60.0 / 255.0)).abs() < 1e-6);
+    // to_uv: Mitsuba maps (u, 1 - v) through scale then translate and reads row v_m from the
+    // top; tessera reads row 1 - (v s_y + o_y). They must agree modulo 1.
+    let t = alpha.children().find(|n| n.attribute("name") == Some("to_uv")).unwrap();
+    let get = |tag: &str, a: &str| -> f32 {
+        t.children().find(|n| n.has_tag_name(tag)).unwrap().attribute(a).unwrap().parse().unwrap()
+    };
+    let (sx, sy, tx, ty) = (get("scale", "x"), get("scale", "y"), get("translate", "x"), get("translate", "y"));
+    for (u, v) in [(0.1f32, 0.2f32), (0.7, 0.9), (0.33, 0.01)] {
+        let (tessera_col, tessera_row) = (u * 3.0 + 0.1, 1.0 - (v * 2.0 + 0.25));
+        let (mitsuba_col, mitsuba_row) = (u * sx + tx, (1.0 - v) * sy + ty);
+        let frac = |x: f32| x - x.floor();
+        assert!((frac(tessera_col) - frac(mitsuba_col)).abs() < 1e-5);
+        assert!((frac(tessera_row) - frac(mitsuba_row)).abs() < 1e-5, "v {v}: {tessera_row} vs {mitsuba_row}");
+    }
+}
+
+#[test]
+fn two_sided_and_normal_mapped_materials_are_wrapped() {
+    let toml = std::fs::read_to_string(common::repo().join("scenes/golden/normal_map.toml")).unwrap();
+    let bumps = std::fs::read(common::repo().join("scenes/golden/textures/bumps.png")).unwrap();
+    let (_dir, _out, xml) = export(&toml, &[("textures/bumps.png", &bumps)]);
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let twosided = doc.descendants().find(|n| n.attribute("type") == Some("twosided")).expect("twosided");
+    let normalmap =
+        twosided.children().find(|n| n.attribute("type") == Some("normalmap")).expect("normalmap inside twosided");
+    assert!(normalmap.children().any(|n| n.attribute("type") == Some("diffuse")));
+    assert!(doc.descendants().any(|n| n.attribute("type") == Some("normalmap")
+        && n.children().any(|c| c.attribute("type") == Some("roughconductor"))));
+}
+
+#[test]
+fn pbr_materials_are_not_exported_silently() {
+    let dir = common::scene_dir(
+        "[camera]\nfov = 30\neye = [0, 0, 4]\ntarget = [0, 0, 0]\n[materials.gold]\ntype = \"pbr\"\n[[shapes]]\ntype = \"cube\"\nmaterial = \"gold\"\n",
+        &[],
+    );
+    let scene = common::load(dir.path()).unwrap();
+    let err = export_mitsuba(&scene, &dir.path().join("out")).unwrap_err().to_string();
+    assert!(err.contains("material 0") && err.contains("no exact Mitsuba 3 equivalent"), "{err}");
+}
