@@ -142,6 +142,10 @@ pub struct Material {
     pub normal_map: Option<TextureId>,
     /// Scatter on both sides (Mitsuba's `twosided` adapter): the back behaves as the front.
     pub two_sided: bool,
+    /// A deformed tiling-and-blending texture whose deformation field orients the shading
+    /// frame: s follows the texture's own x axis, J F^-1 e1 (DESIGN.md section 3), so that
+    /// anisotropic roughness and normal maps follow the synthesised texture, not the UVs.
+    pub texture_frame: Option<TextureId>,
 }
 
 impl ColorParam {
@@ -167,7 +171,12 @@ impl Material {
     /// diffuse with reflectance 0.5, or 0 (black) if the shape is an emitter.
     pub fn default_diffuse(emitter: bool) -> Self {
         let reflectance = ColorParam::Value(Rgb::splat(if emitter { 0.0 } else { 0.5 }));
-        Material { kind: MaterialKind::Diffuse { reflectance }, normal_map: None, two_sided: false }
+        Material {
+            kind: MaterialKind::Diffuse { reflectance },
+            normal_map: None,
+            two_sided: false,
+            texture_frame: None,
+        }
     }
 
     /// The textures this material reads.
@@ -231,16 +240,20 @@ impl Material {
     }
 
     /// The frame the BSDF is evaluated in at a lookup, from the unperturbed shading frame `base`
-    /// (mirrored already for a two-sided material seen from the back).
+    /// (mirrored already for a two-sided material seen from the back) and the position's
+    /// derivatives `dpdu`, `dpdv`.
     ///
-    /// With a normal map, the map's normal is read in `base` and the tangent s re-projected onto
-    /// its plane (Mitsuba's `normalmap`).
-    pub fn shading(&self, textures: &[Texture], ctx: &TexCtx, base: Frame) -> Shading {
-        let Some(id) = self.normal_map else { return Shading { frame: base, base, bump_alpha2: None } };
-        let rgb = textures[id.0 as usize].eval(ctx).truncate();
-        let Some(local) = (rgb * 2.0 - Vec3::ONE).try_normalize() else {
-            return Shading { frame: base, base, bump_alpha2: None };
+    /// With a texture frame, s is first turned in the tangent plane to the texture's x axis.
+    /// With a normal map, the map's normal is read in that frame and the tangent s re-projected
+    /// onto its plane (Mitsuba's `normalmap`).
+    pub fn shading(&self, textures: &[Texture], ctx: &TexCtx, base: Frame, dpdu: Vec3, dpdv: Vec3) -> Shading {
+        let base = match self.texture_frame.and_then(|id| textures[id.0 as usize].tangent_direction(ctx.uv)) {
+            Some((direction, reversed)) => base.turned_towards(dpdu * direction.x + dpdv * direction.y, reversed),
+            None => base,
         };
+        let plain = Shading { frame: base, base, bump_alpha2: None };
+        let Some(id) = self.normal_map else { return plain };
+        let Some(local) = textures[id.0 as usize].eval_normal(ctx) else { return plain };
         // Roughness of the bump-terminator shadowing: alpha^2 = tan^2(theta_d) / 8, theta_d the
         // tilt of the map's normal (Conty Estevez et al. 2019).
         let cos_d = local.z.clamp(1e-6, 1.0);

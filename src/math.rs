@@ -1,4 +1,4 @@
-//! Small numerical tools: quadrature.
+//! Small numerical tools: quadrature, the standard normal distribution.
 
 /// Nodes and weights of the n-point Gauss-Legendre rule on [-1, 1], by Newton iteration on the
 /// Legendre polynomial P_n (Golub-Welsch would do as well; n is small here).
@@ -32,6 +32,64 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (nodes, weights)
 }
 
+/// The standard normal cumulative distribution function Phi(x).
+#[inline]
+pub fn normal_cdf(x: f64) -> f64 {
+    0.5 * libm::erfc(-x / std::f64::consts::SQRT_2)
+}
+
+/// The standard normal quantile Phi^-1(p) for p in (0, 1): Acklam's rational approximation
+/// (relative error 1.2e-9) refined by one Halley step on [`normal_cdf`]. Returns -inf / +inf at
+/// 0 / 1 and NaN outside [0, 1].
+pub fn normal_quantile(p: f64) -> f64 {
+    if !(0.0..=1.0).contains(&p) {
+        return f64::NAN;
+    }
+    if p == 0.0 {
+        return f64::NEG_INFINITY;
+    }
+    if p == 1.0 {
+        return f64::INFINITY;
+    }
+    const A: [f64; 6] = [
+        -3.969683028665376e1,
+        2.209460984245205e2,
+        -2.759285104469687e2,
+        1.383_577_518_672_69e2,
+        -3.066479806614716e1,
+        2.506628277459239,
+    ];
+    const B: [f64; 5] =
+        [-5.447609879822406e1, 1.615858368580409e2, -1.556989798598866e2, 6.680131188771972e1, -1.328068155288572e1];
+    const C: [f64; 6] = [
+        -7.784894002430293e-3,
+        -3.223964580411365e-1,
+        -2.400758277161838,
+        -2.549732539343734,
+        4.374664141464968,
+        2.938163982698783,
+    ];
+    const D: [f64; 4] = [7.784695709041462e-3, 3.224671290700398e-1, 2.445134137142996, 3.754408661907416];
+    let tail = |q: f64| {
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    };
+    let x = if p < 0.02425 {
+        tail((-2.0 * p.ln()).sqrt())
+    } else if p > 1.0 - 0.02425 {
+        -tail((-2.0 * (1.0 - p).ln()).sqrt())
+    } else {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    };
+    // Halley's step: e = Phi(x) - p, u = e sqrt(2 pi) exp(x^2 / 2).
+    let e = normal_cdf(x) - p;
+    let u = e * (2.0 * std::f64::consts::PI).sqrt() * (x * x / 2.0).exp();
+    x - u / (1.0 + x * u / 2.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -48,5 +106,17 @@ mod tests {
             // int_{-1}^{1} x^(2n-2) dx = 2 / (2n - 1)
             assert!((integral - 2.0 / deg as f64).abs() < 1e-10, "n {n}: {integral}");
         }
+    }
+
+    #[test]
+    fn normal_quantile_inverts_the_cdf() {
+        for p in [1e-9, 1e-4, 0.01, 0.02425, 0.2, 0.5, 0.7, 0.975, 0.999_999] {
+            let x = normal_quantile(p);
+            assert!((normal_cdf(x) - p).abs() < 1e-12 * p.max(1e-3), "{p}: {x}");
+        }
+        // Known values.
+        assert!((normal_quantile(0.975) - 1.959963984540054).abs() < 1e-12);
+        assert_eq!(normal_quantile(0.5), 0.0);
+        assert!(normal_quantile(1.5).is_nan());
     }
 }

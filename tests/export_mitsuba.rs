@@ -11,7 +11,7 @@ fn export(scene_toml: &str, files: &[(&str, &[u8])]) -> (tempfile::TempDir, std:
     let dir = common::scene_dir(scene_toml, files);
     let scene = common::load(dir.path()).unwrap_or_else(|e| panic!("{e}"));
     let out = dir.path().join("mitsuba");
-    export_mitsuba(&scene, &out).unwrap_or_else(|e| panic!("{e}"));
+    export_mitsuba(&scene, &out, 256).unwrap_or_else(|e| panic!("{e}"));
     let xml = std::fs::read_to_string(out.join("scene.xml")).unwrap();
     (dir, out, xml)
 }
@@ -25,7 +25,7 @@ fn brushed_metal_exports_as_mitsuba_scene_a() {
     let path = common::repo().join("scenes/golden/brushed_metal.toml");
     let scene = load_scene(&path, &SceneOverrides::default()).unwrap();
     let out = tempfile::tempdir().unwrap();
-    export_mitsuba(&scene, out.path()).unwrap();
+    export_mitsuba(&scene, out.path(), 256).unwrap();
     let xml = std::fs::read_to_string(out.path().join("scene.xml")).unwrap();
     let doc = roxmltree::Document::parse(&xml).expect("well-formed XML");
     let root = doc.root_element();
@@ -161,6 +161,6 @@ fn pbr_materials_are_not_exported_silently() {
         &[],
     );
     let scene = common::load(dir.path()).unwrap();
-    let err = export_mitsuba(&scene, &dir.path().join("out")).unwrap_err().to_string();
+    let err = export_mitsuba(&scene, &dir.path().join("out"), 256).unwrap_err().to_string();
     assert!(err.contains("material 0") && err.contains("no exact Mitsuba 3 equivalent"), "{err}");
 }

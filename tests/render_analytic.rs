@@ -243,7 +243,7 @@ fn normal_mapped_mirror_under_uniform_sky_matches_its_model() {
     let material = &scene.materials[scene.shape_of(si.triangle).material as usize];
     let ctx = TexCtx { uv: si.uv, ..Default::default() };
     let bsdf = material.bsdf(&scene.textures, &ctx);
-    let shading = material.shading(&scene.textures, &ctx, si.frame);
+    let shading = material.shading(&scene.textures, &ctx, si.frame, si.dpdu, si.dpdv);
     let wo = shading.frame.to_local(si.wo);
     let expected = common::integrate_sphere(400, |w| {
         (bsdf.eval(wo, shading.frame.to_local(w)).x * shading.light_factor(w)) as f64

@@ -9,9 +9,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use tessera::error::{Error, Result};
-use tessera::image::{Aov, write_image};
+use tessera::image::{Aov, Bitmap, write_image};
 use tessera::integrator::{Crop, render};
 use tessera::scene::{Scene, SceneOverrides, load_scene};
+use tessera::texture::{BakeFootprint, bake};
 
 /// tessera: a reference path tracer for procedural surface textures.
 #[derive(Parser)]
@@ -92,6 +93,31 @@ enum Command {
         /// Samples per pixel written into the exported scene (default: the scene's).
         #[arg(long)]
         spp: Option<u32>,
+        /// Resolution at which procedural textures are baked over the UV square.
+        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=16384))]
+        bake_res: u32,
+    },
+    /// Evaluate one texture of a scene over the UV square [0, 1]^2, with no light transport
+    /// (EXR: linear RGBA; PNG: sRGB RGB). Row 0 is the top (v = 1).
+    Bake {
+        /// Scene file (TOML) that defines the texture.
+        scene: PathBuf,
+        /// Name of the texture (`[textures.NAME]`).
+        #[arg(long)]
+        texture: String,
+        /// Image width and height in texels.
+        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+        res: u32,
+        /// Output image, .exr or .png.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Read 8-bit images as data (no sRGB decoding), as scalar parameters and normal maps do.
+        #[arg(long)]
+        data: bool,
+        /// Footprint of each lookup: `texel` (one texel of the bake, as a GPU shader drawing the
+        /// UV square sees it) or `point` (unfiltered).
+        #[arg(long, default_value = "texel")]
+        footprint: FootprintArg,
     },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
@@ -106,6 +132,13 @@ enum Command {
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
     },
+}
+
+/// Footprints of `tessera bake`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FootprintArg {
+    Texel,
+    Point,
 }
 
 /// Parse the command line and run it.
@@ -128,13 +161,39 @@ pub fn run() -> Result<ExitCode> {
         Command::Diff { test, reference, variance, spp, max_relmse, max_flip, output } => {
             diff(&test, &reference, variance.as_deref().zip(spp), max_relmse, max_flip, output.as_deref())
         }
-        Command::ExportMitsuba { scene, output, spp } => {
+        Command::ExportMitsuba { scene, output, spp, bake_res } => {
             let scene = load(&scene, &SceneOverrides { spp, ..Default::default() }, false)?;
-            let export = tessera::scene::export_mitsuba(&scene, &output)?;
+            let export = tessera::scene::export_mitsuba(&scene, &output, bake_res as usize)?;
             for w in &export.warnings {
                 eprintln!("warning: {w}");
             }
             eprintln!("{}: wrote {} files to {}", scene.path.display(), export.files.len(), output.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Bake { scene, texture, res, output, data, footprint } => {
+            tessera::image::OutputFormat::from_path(&output)?;
+            let tex = tessera::scene::load_texture(&scene, &texture, !data)?;
+            let footprint = match footprint {
+                FootprintArg::Texel => BakeFootprint::Texel,
+                FootprintArg::Point => BakeFootprint::Point,
+            };
+            let start = Instant::now();
+            let image = bake(&tex, res as usize, footprint);
+            let rgb = Bitmap {
+                width: image.width,
+                height: image.height,
+                channels: 3,
+                data: image.data.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect(),
+            };
+            let mut alpha = Bitmap::new(image.width, image.height, 1);
+            alpha.data = image.data.chunks_exact(4).map(|p| p[3]).collect();
+            write_image(&output, &rgb, &[(&["A"], alpha)])?;
+            eprintln!(
+                "{}: baked texture '{texture}' at {res}x{res} in {:.2} s to {}",
+                scene.display(),
+                start.elapsed().as_secs_f64(),
+                output.display()
+            );
             Ok(ExitCode::SUCCESS)
         }
         Command::Bench { runs, threads, scenes } => {

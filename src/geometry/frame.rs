@@ -40,6 +40,19 @@ impl Frame {
         Frame { s, t: n.cross(s), n }
     }
 
+    /// The frame turned about n so that s points along the tangent-plane part of `direction`
+    /// (t turning with it, negated when `reversed`); unchanged when `direction` has none.
+    pub fn turned_towards(&self, direction: Vec3, reversed: bool) -> Self {
+        let (c, s) = (direction.dot(self.s), direction.dot(self.t));
+        let len = (c * c + s * s).sqrt();
+        if !(len > 0.0 && len.is_finite()) {
+            return *self;
+        }
+        let (c, s) = (c / len, s / len);
+        let t = self.t * c - self.s * s;
+        Frame { s: self.s * c + self.t * s, t: if reversed { -t } else { t }, n: self.n }
+    }
+
     /// World direction to local coordinates.
     #[inline]
     pub fn to_local(&self, v: Vec3) -> Vec3 {

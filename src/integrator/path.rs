@@ -123,7 +123,7 @@ impl<'a> PathTracer<'a> {
             if material.two_sided && base.n.dot(si.wo) < 0.0 {
                 base = Frame { n: -base.n, ..base };
             }
-            let shading = material.shading(&scene.textures, &ctx, base);
+            let shading = material.shading(&scene.textures, &ctx, base, si.dpdu, si.dpdv);
             let frame = shading.frame;
             let wo = frame.to_local(si.wo);
             if depth == 0 {

@@ -17,7 +17,7 @@ pub struct Sampler {
 /// A 64-bit finaliser with full avalanche (Stafford's "Mix13" variant of the MurmurHash3
 /// finaliser, as used by SplitMix64).
 #[inline(always)]
-fn mix64(mut z: u64) -> u64 {
+pub(crate) fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)

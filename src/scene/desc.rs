@@ -126,6 +126,110 @@ pub enum TextureDesc {
         #[serde(default)]
         offset: [f32; 2],
     },
+    /// Tiling and blending of an exemplar, optionally deformed (paper 000 Sec. 3).
+    TilingBlending(Box<TilingBlendingDesc>),
+}
+
+/// `type = "tiling_blending"`: an exemplar read through tiles, shifts, a deformation field and
+/// a blending operator. A layer (`layer_of`) takes all of those from another such texture.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TilingBlendingDesc {
+    /// The exemplar: the name of another texture (usually an image).
+    pub exemplar: String,
+    /// Name of a tiling_blending texture whose tiles, shifts, deformation and weights this one
+    /// shares (the layers of a PBR material); the synthesis keys below must then be left out.
+    pub layer_of: Option<String>,
+    /// `hexagonal` (k = 3, default) or `square` (k = 4).
+    pub tiling: Option<crate::texture::tiling_blending::Tiling>,
+    /// Lattice spacing in UV units (default 0.25).
+    pub tile_size: Option<f32>,
+    /// Seed of the tiles' shifts (default 0).
+    pub seed: Option<u64>,
+    /// Blending operator (default `linear`).
+    pub blend: Option<BlendKind>,
+    /// `sharpened`: power on the paving's weights (default 7).
+    pub exponent: Option<f32>,
+    /// `sharpened`: weight of the tiles' luminance in [0, 1] (default 0.6).
+    pub luminance_contrast: Option<f32>,
+    /// `mix_max`: the priority map (an image texture's name).
+    pub priority: Option<String>,
+    /// `mix_max`: spread of sub-footprint priorities (default 0.05; 0 cuts sharply).
+    pub lambda: Option<f32>,
+    /// `mix_max`: factor on the priorities against the tiles' weights (default 4).
+    pub contrast: Option<f32>,
+    /// The deformation field F as a product of factors, F = F_1 F_2 ... (default: none, which
+    /// is classical tiling and blending).
+    pub deformation: Option<Vec<DeformationDesc>>,
+}
+
+/// A scale: one number for both axes, or [along u, along v].
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
+#[serde(untagged, expecting = "a number or [along u, along v]")]
+pub enum ScaleValue {
+    /// The same on both axes.
+    Uniform(f32),
+    /// Per axis.
+    PerAxis([f32; 2]),
+}
+
+/// Blending operators of tiling and blending.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BlendKind {
+    /// Weighted sum with the paving's weights.
+    Linear,
+    /// Heitz-Neyret's variance-preserving operator.
+    VariancePreserving,
+    /// Variance-preserving on the Gaussianized exemplar, then its inverse histogram transform.
+    HistogramPreserving,
+    /// Mikkelsen's sharpened, luminance-weighted weights.
+    Sharpened,
+    /// Fournier-Sauvage's Mix-Max with a priority map.
+    MixMax,
+}
+
+/// One factor of a deformation field F (maps UV offsets to exemplar offsets; F = s I shows the
+/// pattern 1/s as large).
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum DeformationDesc {
+    /// A constant matrix, row-major [F00, F01, F10, F11].
+    Matrix {
+        /// The matrix.
+        matrix: [f32; 4],
+    },
+    /// A rotation by angle + gradient . uv degrees.
+    Rotation {
+        /// Angle at uv = (0, 0), degrees (default 0).
+        #[serde(default)]
+        angle: f32,
+        /// Degrees per UV unit along u and v (default [0, 0]).
+        #[serde(default)]
+        gradient: [f32; 2],
+    },
+    /// A scaling diag(scale) 2^(gradient . uv).
+    Scale {
+        /// Scale at uv = (0, 0): a number or [along u, along v] (default 1).
+        scale: Option<ScaleValue>,
+        /// Change of log2(scale) per UV unit along u and v (default [0, 0]).
+        #[serde(default)]
+        gradient: [f32; 2],
+    },
+    /// A shear [[1, k], [0, 1]], k = shear + gradient . uv.
+    Shear {
+        /// Shear at uv = (0, 0) (default 0).
+        #[serde(default)]
+        shear: f32,
+        /// Change of the shear per UV unit along u and v (default [0, 0]).
+        #[serde(default)]
+        gradient: [f32; 2],
+    },
+    /// An F map: a 4-channel EXR (F00, F01, F10, F11), bilinear.
+    Map {
+        /// The EXR file.
+        filename: String,
+    },
 }
 
 /// `[materials.NAME]`. Parameter names and defaults follow Mitsuba 3's plugins.

@@ -113,7 +113,7 @@ impl TextureCache<'_> {
         let image = info_texture.source().index();
         *self.loaded.entry((image, space)).or_insert_with(|| {
             self.textures.push(Texture::Image(ImageTexture {
-                mipmap: MipMap::new(bitmap(&self.images[image], space)),
+                mipmap: Arc::new(MipMap::new(bitmap(&self.images[image], space))),
                 filter: Filter::None,
                 scale: Vec2::ONE,
                 offset: Vec2::ZERO,
@@ -171,6 +171,7 @@ fn convert_material(
         kind: MaterialKind::Pbr { base_color, metallic, roughness, tables },
         normal_map,
         two_sided: m.double_sided(),
+        texture_frame: None,
     }
 }
 

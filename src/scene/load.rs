@@ -2,8 +2,8 @@
 //! scene file; every error names the scene file and the item, and the file at fault.
 
 use super::desc::{
-    CameraDesc, ColorValue, EnvironmentDesc, FloatValue, IorValue, MaterialDesc, RenderDesc, RgbValue, SceneDesc,
-    ShapeDesc, ShapeKind, TextureDesc, TransformStep,
+    BlendKind, CameraDesc, ColorValue, DeformationDesc, EnvironmentDesc, FloatValue, IorValue, MaterialDesc,
+    RenderDesc, RgbValue, ScaleValue, SceneDesc, ShapeDesc, ShapeKind, TextureDesc, TilingBlendingDesc, TransformStep,
 };
 use super::{Geometry, RenderSettings, Scene};
 use crate::accel::Accel;
@@ -17,9 +17,11 @@ use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
 };
-use crate::texture::{ImageTexture, MipMap, Texture};
-use glam::{Mat4, Vec2, Vec3};
+use crate::texture::tiling_blending::{Blend, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
+use crate::texture::{ImageTexture, MipMap, Texture, TilingBlending};
+use glam::{Mat2, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
+use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
@@ -53,11 +55,25 @@ pub fn load_scene(path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
 
 /// Load a scene from its text; `path` names it in messages and anchors its relative paths.
 pub fn load_scene_str(text: &str, path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
-    let desc: SceneDesc = toml::from_str(text).map_err(|e| {
+    let desc = parse_scene(text, path)?;
+    Loader::new(path, &desc).load(&desc, overrides)
+}
+
+/// Parse a scene file's text; errors give the line.
+fn parse_scene(text: &str, path: &Path) -> Result<SceneDesc> {
+    toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
         Error::Scene { path: path.to_path_buf(), line, msg: e.message().to_string() }
-    })?;
-    Loader::new(path, &desc).load(&desc, overrides)
+    })
+}
+
+/// Load the texture `name` of a scene file alone, as a colour (8-bit images sRGB-decoded) or
+/// as data (`color` false), for `tessera bake`.
+pub fn load_texture(path: &Path, name: &str, color: bool) -> Result<Texture> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let desc = parse_scene(&text, path)?;
+    let role = if color { Role::Color } else { Role::Data };
+    Ok(Loader::new(path, &desc).build_texture(name, role, "--texture")?.0)
 }
 
 /// The IOR-1.5 tables shared by every `pbr` material (computed once per process).
@@ -79,6 +95,9 @@ struct Loader<'a> {
     texture_descs: &'a std::collections::BTreeMap<String, TextureDesc>,
     textures: Vec<Texture>,
     loaded_textures: HashMap<(String, ColorSpace), TextureId>,
+    built_textures: HashMap<(String, ColorSpace), Texture>,
+    textures_in_progress: Vec<String>,
+    syntheses: HashMap<String, Arc<Synthesis>>,
     plastic_tables: HashMap<(u32, u32), Arc<PlasticTables>>,
     warnings: Vec<String>,
 }
@@ -92,6 +111,9 @@ impl<'a> Loader<'a> {
             texture_descs: &desc.textures,
             textures: Vec::new(),
             loaded_textures: HashMap::new(),
+            built_textures: HashMap::new(),
+            textures_in_progress: Vec::new(),
+            syntheses: HashMap::new(),
             plastic_tables: HashMap::new(),
             warnings: Vec::new(),
         }
@@ -225,31 +247,229 @@ impl<'a> Loader<'a> {
     }
 
     fn texture(&mut self, name: &str, role: Role, item: &str) -> Result<TextureId> {
-        let Some(TextureDesc::Image { filename, filter, colorspace, scale, offset }) = self.texture_descs.get(name)
-        else {
+        let (texture, key) = self.build_texture(name, role, item)?;
+        if let Some(id) = self.loaded_textures.get(&key) {
+            return Ok(*id);
+        }
+        let id = self.add_texture(texture);
+        self.loaded_textures.insert(key, id);
+        Ok(id)
+    }
+
+    /// The texture `name` as `role` uses it (built once per colour space), and its cache key.
+    fn build_texture(&mut self, name: &str, role: Role, item: &str) -> Result<(Texture, (String, ColorSpace))> {
+        let Some(desc) = self.texture_descs.get(name) else {
             return Err(self.error(format!(
                 "{item}: unknown texture '{name}' (defined: {})",
                 self.texture_descs.keys().cloned().collect::<Vec<_>>().join(", ")
             )));
         };
-        let space = colorspace.unwrap_or(if role == Role::Color { ColorSpace::Srgb } else { ColorSpace::Linear });
-        if let Some(id) = self.loaded_textures.get(&(name.to_string(), space)) {
-            return Ok(*id);
+        let role_space = if role == Role::Color { ColorSpace::Srgb } else { ColorSpace::Linear };
+        let space = match desc {
+            TextureDesc::Image { colorspace, .. } => colorspace.unwrap_or(role_space),
+            TextureDesc::TilingBlending(_) => role_space,
+        };
+        let key = (name.to_string(), space);
+        if let Some(t) = self.built_textures.get(&key) {
+            return Ok((t.clone(), key));
         }
-        let file = self.resolve_path(filename);
-        let bitmap = read_bitmap(&file, space).map_err(|e| e.in_scene(self.path, format!("textures.{name}")))?;
-        if !(scale.iter().chain(offset).all(|v| v.is_finite())) {
-            return Err(self.error(format!("textures.{name}: scale and offset must be finite")));
+        if self.textures_in_progress.iter().any(|n| n == name) {
+            return Err(self.error(format!(
+                "textures.{name}: refers to itself (through {})",
+                self.textures_in_progress.join(" -> ")
+            )));
         }
-        let texture = Texture::Image(ImageTexture {
-            mipmap: MipMap::new(bitmap),
-            filter: *filter,
-            scale: Vec2::from(*scale),
-            offset: Vec2::from(*offset),
+        self.textures_in_progress.push(name.to_string());
+        let texture = match desc {
+            TextureDesc::Image { filename, filter, scale, offset, .. } => {
+                let file = self.resolve_path(filename);
+                let bitmap =
+                    read_bitmap(&file, space).map_err(|e| e.in_scene(self.path, format!("textures.{name}")))?;
+                if !(scale.iter().chain(offset).all(|v| v.is_finite())) {
+                    return Err(self.error(format!("textures.{name}: scale and offset must be finite")));
+                }
+                Texture::Image(ImageTexture {
+                    mipmap: Arc::new(MipMap::new(bitmap)),
+                    filter: *filter,
+                    scale: Vec2::from(*scale),
+                    offset: Vec2::from(*offset),
+                })
+            }
+            TextureDesc::TilingBlending(d) => self.tiling_blending(name, d, role)?,
+        };
+        self.textures_in_progress.pop();
+        self.built_textures.insert(key.clone(), texture.clone());
+        Ok((texture, key))
+    }
+
+    /// A tiling-and-blending texture: its synthesis (shared with `layer_of`) and its exemplar.
+    fn tiling_blending(&mut self, name: &str, d: &TilingBlendingDesc, role: Role) -> Result<Texture> {
+        let item = format!("textures.{name}");
+        let synthesis = self.synthesis(name, d)?;
+        // The sharpened operator weighs by the first layer's exemplar: share it when this is it.
+        let exemplar = match &synthesis.blend {
+            Blend::Sharpened { source, .. } if d.layer_of.is_none() && role == Role::Color => source.clone(),
+            _ => Arc::new(self.build_texture(&d.exemplar, role, &format!("{item}.exemplar"))?.0),
+        };
+        let texture = TilingBlending::new(synthesis, exemplar).map_err(|msg| self.error(format!("{item}: {msg}")))?;
+        Ok(Texture::TilingBlending(texture))
+    }
+
+    /// The synthesis of tiling-and-blending texture `name`, or of the texture it is a layer of.
+    fn synthesis(&mut self, name: &str, d: &TilingBlendingDesc) -> Result<Arc<Synthesis>> {
+        let item = format!("textures.{name}");
+        if let Some(master) = &d.layer_of {
+            let own = [
+                ("tiling", d.tiling.is_some()),
+                ("tile_size", d.tile_size.is_some()),
+                ("seed", d.seed.is_some()),
+                ("blend", d.blend.is_some()),
+                ("exponent", d.exponent.is_some()),
+                ("luminance_contrast", d.luminance_contrast.is_some()),
+                ("priority", d.priority.is_some()),
+                ("lambda", d.lambda.is_some()),
+                ("contrast", d.contrast.is_some()),
+                ("deformation", d.deformation.is_some()),
+            ];
+            if let Some((key, _)) = own.iter().find(|(_, set)| *set) {
+                return Err(
+                    self.error(format!("{item}: a layer takes its {key} from '{master}' (layer_of); leave it out"))
+                );
+            }
+            return match self.texture_descs.get(master.as_str()) {
+                Some(TextureDesc::TilingBlending(m)) if m.layer_of.is_none() => self.synthesis(master, m),
+                Some(TextureDesc::TilingBlending(_)) => {
+                    Err(self.error(format!("{item}.layer_of: '{master}' is itself a layer; name its first layer")))
+                }
+                _ => Err(self.error(format!("{item}.layer_of: '{master}' is not a tiling_blending texture"))),
+            };
+        }
+        if let Some(s) = self.syntheses.get(name) {
+            return Ok(s.clone());
+        }
+        let tile_size = d.tile_size.unwrap_or(0.25);
+        if !(tile_size > 1e-6 && tile_size <= 1e4) {
+            return Err(self.error(format!("{item}.tile_size: {tile_size} is not in (1e-6, 1e4] UV units")));
+        }
+        let kind = d.blend.unwrap_or(BlendKind::Linear);
+        let misplaced = [
+            ("exponent", d.exponent.is_some(), BlendKind::Sharpened),
+            ("luminance_contrast", d.luminance_contrast.is_some(), BlendKind::Sharpened),
+            ("priority", d.priority.is_some(), BlendKind::MixMax),
+            ("lambda", d.lambda.is_some(), BlendKind::MixMax),
+            ("contrast", d.contrast.is_some(), BlendKind::MixMax),
+        ];
+        if let Some((key, _, needs)) = misplaced.iter().find(|(_, set, needs)| *set && *needs != kind) {
+            return Err(self.error(format!("{item}.{key}: only used with blend = \"{}\"", blend_name(*needs))));
+        }
+        let blend = match kind {
+            BlendKind::Linear => Blend::Linear,
+            BlendKind::VariancePreserving => Blend::VariancePreserving,
+            BlendKind::HistogramPreserving => Blend::HistogramPreserving,
+            BlendKind::Sharpened => {
+                let exponent = d.exponent.unwrap_or(7.0);
+                let luminance_contrast = d.luminance_contrast.unwrap_or(0.6);
+                if !(exponent > 0.0 && exponent <= 64.0) {
+                    return Err(self.error(format!("{item}.exponent: {exponent} is not in (0, 64]")));
+                }
+                if !(0.0..=1.0).contains(&luminance_contrast) {
+                    return Err(self.error(format!("{item}.luminance_contrast: {luminance_contrast} is not in [0, 1]")));
+                }
+                let source = Arc::new(self.build_texture(&d.exemplar, Role::Color, &format!("{item}.exemplar"))?.0);
+                Blend::Sharpened { exponent, luminance_contrast, source }
+            }
+            BlendKind::MixMax => {
+                let Some(priority) = &d.priority else {
+                    return Err(
+                        self.error(format!("{item}: blend = \"mix_max\" needs a priority map (priority = NAME)"))
+                    );
+                };
+                let lambda = d.lambda.unwrap_or(0.05);
+                if !(0.0..=1e3).contains(&lambda) {
+                    return Err(self.error(format!("{item}.lambda: {lambda} is not in [0, 1000]")));
+                }
+                let Texture::Image(image) = self.build_texture(priority, Role::Data, &format!("{item}.priority"))?.0
+                else {
+                    return Err(self.error(format!("{item}.priority: '{priority}' must be an image texture")));
+                };
+                let contrast = d.contrast.unwrap_or(4.0);
+                if !(contrast > 0.0 && contrast <= 1e3) {
+                    return Err(self.error(format!("{item}.contrast: {contrast} is not in (0, 1000]")));
+                }
+                Blend::MixMax { priority: PriorityMap::new(&image), contrast, lambda }
+            }
+        };
+        let deformation = match &d.deformation {
+            None => None,
+            Some(factors) => Some(DeformationField::new(
+                factors
+                    .iter()
+                    .enumerate()
+                    .map(|(i, f)| self.deformation(f, &format!("{item}.deformation[{i}]")))
+                    .collect::<Result<_>>()?,
+            )),
+        };
+        let synthesis = Arc::new(Synthesis {
+            tiling: d.tiling.unwrap_or(Tiling::Hexagonal),
+            tile_size,
+            seed: d.seed.unwrap_or(0),
+            deformation,
+            blend,
         });
-        let id = self.add_texture(texture);
-        self.loaded_textures.insert((name.to_string(), space), id);
-        Ok(id)
+        self.syntheses.insert(name.to_string(), synthesis.clone());
+        Ok(synthesis)
+    }
+
+    /// One factor of a deformation field.
+    fn deformation(&self, f: &DeformationDesc, item: &str) -> Result<Deformation> {
+        let finite = |values: &[f32]| values.iter().all(|v| v.is_finite());
+        let bad = || self.error(format!("{item}: values must be finite numbers"));
+        Ok(match f {
+            DeformationDesc::Matrix { matrix: m } => {
+                if !finite(m) {
+                    return Err(bad());
+                }
+                Deformation::Constant(Mat2::from_cols(Vec2::new(m[0], m[2]), Vec2::new(m[1], m[3])))
+            }
+            DeformationDesc::Rotation { angle, gradient } => {
+                if !finite(&[*angle, gradient[0], gradient[1]]) {
+                    return Err(bad());
+                }
+                Deformation::Rotation { angle: angle.to_radians(), gradient: Vec2::from(*gradient) * (PI / 180.0) }
+            }
+            DeformationDesc::Scale { scale, gradient } => {
+                let scale = match scale {
+                    None => Vec2::ONE,
+                    Some(ScaleValue::Uniform(s)) => Vec2::splat(*s),
+                    Some(ScaleValue::PerAxis(s)) => Vec2::from(*s),
+                };
+                if !finite(&[scale.x, scale.y, gradient[0], gradient[1]]) || scale.x == 0.0 || scale.y == 0.0 {
+                    return Err(self.error(format!("{item}: the scale must be finite and non-zero")));
+                }
+                Deformation::Scale { scale, gradient: Vec2::from(*gradient) }
+            }
+            DeformationDesc::Shear { shear, gradient } => {
+                if !finite(&[*shear, gradient[0], gradient[1]]) {
+                    return Err(bad());
+                }
+                Deformation::Shear { shear: *shear, gradient: Vec2::from(*gradient) }
+            }
+            DeformationDesc::Map { filename } => {
+                let file = self.resolve_path(filename);
+                let bitmap = read_bitmap(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, item))?;
+                if bitmap.channels != 4 {
+                    return Err(Error::image(
+                        &file,
+                        format!("an F map needs 4 channels (F00, F01, F10, F11), found {}", bitmap.channels),
+                    )
+                    .in_scene(self.path, item));
+                }
+                if !finite(&bitmap.data) {
+                    return Err(Error::image(&file, "the F map holds NaN or infinite values").in_scene(self.path, item));
+                }
+                Deformation::Map(MipMap::new(bitmap))
+            }
+        })
     }
 
     fn add_texture(&mut self, texture: Texture) -> TextureId {
@@ -441,7 +661,29 @@ impl<'a> Loader<'a> {
             }
         };
         let normal_map = self.normal_map(normal_map, item)?;
-        Ok(Material { kind, normal_map, two_sided })
+        let mut material = Material { kind, normal_map, two_sided, texture_frame: None };
+        material.texture_frame = self.texture_frame(&material, item)?;
+        Ok(material)
+    }
+
+    /// The texture whose deformation field orients the material's frame: its deformed
+    /// tiling-and-blending textures must share one synthesis (be layers of one texture).
+    fn texture_frame(&self, material: &Material, item: &str) -> Result<Option<TextureId>> {
+        let deformed: Vec<(TextureId, &Arc<Synthesis>)> = material
+            .textures()
+            .into_iter()
+            .filter_map(|id| match &self.textures[id.0 as usize] {
+                Texture::TilingBlending(t) if t.synthesis.deformation.is_some() => Some((id, &t.synthesis)),
+                _ => None,
+            })
+            .collect();
+        if deformed.windows(2).any(|w| !Arc::ptr_eq(w[0].1, w[1].1)) {
+            return Err(self.error(format!(
+                "{item}: its textures have different deformation fields, but the material's frame follows one: \
+                 make them layers of one tiling_blending texture (layer_of)"
+            )));
+        }
+        Ok(deformed.first().map(|d| d.0))
     }
 
     fn transform(&self, steps: &[TransformStep], item: &str) -> Result<Mat4> {
@@ -582,6 +824,17 @@ fn mitsuba_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
     let left = up.cross(dir).try_normalize()?;
     let new_up = dir.cross(left);
     Some(Mat4::from_cols(left.extend(0.0), new_up.extend(0.0), dir.extend(0.0), origin.extend(1.0)))
+}
+
+/// The scene-file name of a blending operator.
+fn blend_name(kind: BlendKind) -> &'static str {
+    match kind {
+        BlendKind::Linear => "linear",
+        BlendKind::VariancePreserving => "variance_preserving",
+        BlendKind::HistogramPreserving => "histogram_preserving",
+        BlendKind::Sharpened => "sharpened",
+        BlendKind::MixMax => "mix_max",
+    }
 }
 
 #[cfg(test)]

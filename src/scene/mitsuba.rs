@@ -27,8 +27,8 @@ use crate::error::{Error, Result};
 use crate::image::write_exr;
 use crate::light::Environment;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
-use crate::texture::{Channel, Filter, Texture};
-use glam::Mat4;
+use crate::texture::{BakeFootprint, Channel, Filter, Texture, bake};
+use glam::{Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -55,6 +55,7 @@ fn rgb_value(c: Rgb) -> String {
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 enum BakeKind {
     Color([u32; 3]),
+    Normal,
     Scalar(u8, u32),
 }
 
@@ -62,6 +63,7 @@ struct Exporter<'a> {
     scene: &'a Scene,
     dir: &'a Path,
     baked: HashMap<(TextureId, BakeKind), String>,
+    bake_res: usize,
     out: MitsubaExport,
 }
 
@@ -78,18 +80,36 @@ impl Exporter<'_> {
     }
 
     /// Bake texture `id` as tessera reads it and return its `<texture>` element for `name`.
+    /// Images are written at their resolution; procedural textures are evaluated over the UV
+    /// square at the export's bake resolution (point lookups).
     fn texture(&mut self, id: TextureId, kind: BakeKind, name: &str) -> Result<String> {
-        let Texture::Image(tex) = &self.scene.textures[id.0 as usize];
-        if tex.filter != Filter::None {
-            self.out.warnings.push(format!(
-                "texture {} uses the {:?} filter; Mitsuba 3.9 has no MIP-mapping, so it is exported bilinear",
-                id.0, tex.filter
-            ));
-        }
+        let texture = &self.scene.textures[id.0 as usize];
+        let (scale, offset) = match texture {
+            Texture::Image(tex) => {
+                if tex.filter != Filter::None {
+                    self.out.warnings.push(format!(
+                        "texture {} uses the {:?} filter; Mitsuba 3.9 has no MIP-mapping, so it is exported bilinear",
+                        id.0, tex.filter
+                    ));
+                }
+                (tex.scale, tex.offset)
+            }
+            Texture::TilingBlending(_) => {
+                self.out.warnings.push(format!(
+                    "texture {} is procedural: baked over the UV square at {res}x{res} (lookups outside [0, 1] repeat the bake)",
+                    id.0,
+                    res = self.bake_res
+                ));
+                (Vec2::ONE, Vec2::ZERO)
+            }
+        };
         let file = match self.baked.get(&(id, kind)) {
             Some(f) => f.clone(),
             None => {
-                let image = tex.mipmap.level(0);
+                let image = match texture {
+                    Texture::Image(tex) => std::borrow::Cow::Borrowed(tex.mipmap.level(0)),
+                    procedural => std::borrow::Cow::Owned(bake(procedural, self.bake_res, BakeFootprint::Point)),
+                };
                 let (w, h) = (image.width, image.height);
                 let pixels = (0..h).flat_map(|y| (0..w).map(move |x| (x, y)));
                 let (file, channels) = match kind {
@@ -99,6 +119,25 @@ impl Exporter<'_> {
                         let values: Vec<Rgb> = pixels.map(|(x, y)| image.pixel(x, y).truncate() * scale).collect();
                         let plane = |c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
                         let file = format!("textures/texture{}_rgb{}.exr", id.0, self.baked.len());
+                        (file, vec![("R".into(), plane(0)), ("G".into(), plane(1)), ("B".into(), plane(2))])
+                    }
+                    BakeKind::Normal => {
+                        // The normal tessera shades with, encoded as Mitsuba's normalmap reads it.
+                        let values: Vec<Vec3> = pixels
+                            .map(|(x, y)| {
+                                let uv =
+                                    Vec2::new(x as f32 + 0.5, (h - 1 - y) as f32 + 0.5) / Vec2::new(w as f32, h as f32);
+                                let n = match texture {
+                                    Texture::Image(_) => image.pixel(x, y).truncate() * 2.0 - Vec3::ONE,
+                                    procedural => procedural
+                                        .eval_normal(&crate::texture::TexCtx { uv, ..Default::default() })
+                                        .unwrap_or(Vec3::Z),
+                                };
+                                (n + Vec3::ONE) * 0.5
+                            })
+                            .collect();
+                        let plane = |c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
+                        let file = format!("textures/texture{}_normal{}.exr", id.0, self.baked.len());
                         (file, vec![("R".into(), plane(0)), ("G".into(), plane(1)), ("B".into(), plane(2))])
                     }
                     BakeKind::Scalar(channel, scale) => {
@@ -117,7 +156,7 @@ impl Exporter<'_> {
         };
         // tessera reads uv' = uv s + o with v up; Mitsuba's v runs down (v_m = 1 - v), so the same
         // lookup is v_m' = v_m s_y + (1 - s_y - o_y).
-        let (s, o) = (tex.scale, tex.offset);
+        let (s, o) = (scale, offset);
         Ok(format!(
             "<texture type=\"bitmap\" name=\"{name}\">\
              <string name=\"filename\" value=\"{}\"/>\
@@ -216,7 +255,7 @@ impl Exporter<'_> {
         };
         let mut bsdf = inner;
         if let Some(map) = m.normal_map {
-            let texture = self.texture(map, BakeKind::Color([1.0f32.to_bits(); 3]), "normalmap")?;
+            let texture = self.texture(map, BakeKind::Normal, "normalmap")?;
             bsdf = format!("<bsdf type=\"normalmap\">{texture}{bsdf}</bsdf>");
         }
         if m.two_sided {
@@ -308,12 +347,13 @@ impl Exporter<'_> {
     }
 }
 
-/// Write `scene` as Mitsuba 3 XML to `dir/scene.xml`, with meshes and textures beside it.
-pub fn export_mitsuba(scene: &Scene, dir: &Path) -> Result<MitsubaExport> {
+/// Write `scene` as Mitsuba 3 XML to `dir/scene.xml`, with meshes and textures beside it;
+/// procedural textures are baked at `bake_res` x `bake_res`.
+pub fn export_mitsuba(scene: &Scene, dir: &Path, bake_res: usize) -> Result<MitsubaExport> {
     for sub in ["", "meshes", "textures"] {
         std::fs::create_dir_all(dir.join(sub)).map_err(|e| Error::io(dir.join(sub), e))?;
     }
-    let mut ex = Exporter { scene, dir, baked: HashMap::new(), out: MitsubaExport::default() };
+    let mut ex = Exporter { scene, dir, baked: HashMap::new(), bake_res, out: MitsubaExport::default() };
     let s = &scene.settings;
     let max_depth = s.max_depth.map_or(-1, i64::from);
     let mut xml = format!(

@@ -6,7 +6,7 @@ mod gltf;
 mod load;
 mod mitsuba;
 
-pub use load::{SceneOverrides, load_scene, load_scene_str};
+pub use load::{SceneOverrides, load_scene, load_scene_str, load_texture};
 pub use mitsuba::{MitsubaExport, export_mitsuba};
 
 use crate::accel::Accel;

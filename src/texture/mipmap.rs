@@ -149,14 +149,29 @@ impl MipMap {
         let st = st - st.floor();
         match filter {
             Filter::None => self.bilinear(0, st),
-            Filter::Trilinear => {
-                let base = &self.levels[0];
-                let size = Vec2::new(base.width as f32, base.height as f32);
-                let width = 2.0 * (dst0 * size).abs().max((dst1 * size).abs()).max_element();
-                self.at_level(self.lod(width), |level| self.bilinear(level, st))
-            }
+            Filter::Trilinear => self.at_level(self.trilinear_lod(dst0, dst1), |level| self.bilinear(level, st)),
             Filter::Ewa => self.ewa(st, dst0, dst1),
         }
+    }
+
+    /// The continuous MIP level a lookup with `filter` over the footprint `dst0`, `dst1` reads
+    /// (0 for `none`; for `ewa`, the level of the ellipse's shorter axis after clamping).
+    pub fn filter_lod(&self, filter: Filter, dst0: Vec2, dst1: Vec2) -> f32 {
+        match filter {
+            Filter::None => 0.0,
+            Filter::Trilinear => self.trilinear_lod(dst0, dst1),
+            Filter::Ewa => self.ewa_axes(dst0, dst1).map_or(0.0, |(_, _, shorter)| self.lod(shorter)),
+        }
+    }
+
+    fn size(&self) -> Vec2 {
+        Vec2::new(self.levels[0].width as f32, self.levels[0].height as f32)
+    }
+
+    /// Level of a trilinear lookup: where the footprint's bounding square spans one texel.
+    fn trilinear_lod(&self, dst0: Vec2, dst1: Vec2) -> f32 {
+        let size = self.size();
+        self.lod(2.0 * (dst0 * size).abs().max((dst1 * size).abs()).max_element())
     }
 
     /// Continuous level at which a footprint `width` texels wide (at level 0) spans one texel.
@@ -171,9 +186,11 @@ impl MipMap {
         if t == 0.0 || i + 1 >= self.levels.len() { f(i) } else { f(i) * (1.0 - t) + f(i + 1) * t }
     }
 
-    fn ewa(&self, st: Vec2, mut dst0: Vec2, mut dst1: Vec2) -> Vec4 {
-        let base = &self.levels[0];
-        let size = Vec2::new(base.width as f32, base.height as f32);
+    /// The EWA ellipse's axes (longer first, the shorter widened to at most `MAX_ANISOTROPY`
+    /// times shorter than the longer) and the shorter one's length in texels; None when the
+    /// ellipse is degenerate.
+    fn ewa_axes(&self, mut dst0: Vec2, mut dst1: Vec2) -> Option<(Vec2, Vec2, f32)> {
+        let size = self.size();
         if (dst0 * size).length_squared() < (dst1 * size).length_squared() {
             std::mem::swap(&mut dst0, &mut dst1);
         }
@@ -185,10 +202,16 @@ impl MipMap {
             dst1 *= scale;
             shorter *= scale;
         }
-        if shorter == 0.0 || !shorter.is_finite() {
-            return self.bilinear(0, st);
+        (shorter > 0.0 && shorter.is_finite()).then_some((dst0, dst1, shorter))
+    }
+
+    fn ewa(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
+        match self.ewa_axes(dst0, dst1) {
+            Some((dst0, dst1, shorter)) => {
+                self.at_level(self.lod(shorter), |level| self.ewa_level(level, st, dst0, dst1))
+            }
+            None => self.bilinear(0, st),
         }
-        self.at_level(self.lod(shorter), |level| self.ewa_level(level, st, dst0, dst1))
     }
 
     /// EWA over one level: Gaussian weights inside the ellipse spanned by `dst0` and `dst1`

@@ -4,11 +4,16 @@
 //! (the change of uv across one pixel in x and y, from ray differentials, DESIGN.md section 9).
 //! Values are RGBA; scalar parameters read one channel or the mean of RGB.
 
+mod bake;
 mod mipmap;
+pub mod tiling_blending;
 
+pub use bake::{BakeFootprint, bake};
 pub use mipmap::{Filter, MipMap};
+pub use tiling_blending::TilingBlending;
 
-use glam::{Vec2, Vec4};
+use glam::{Vec2, Vec3, Vec4};
+use std::sync::Arc;
 
 /// Where and how large a texture lookup is.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -57,7 +62,7 @@ impl Channel {
 #[derive(Clone, Debug)]
 pub struct ImageTexture {
     /// The image and its pyramid.
-    pub mipmap: MipMap,
+    pub mipmap: Arc<MipMap>,
     /// How lookups are filtered.
     pub filter: Filter,
     /// Scale applied to the texture coordinates.
@@ -72,8 +77,18 @@ impl ImageTexture {
         let uv = ctx.uv * self.scale + self.offset;
         // Image coordinates: x right, y down from the top row (DESIGN.md section 3).
         let st = Vec2::new(uv.x, 1.0 - uv.y);
-        let flip = |d: Vec2| Vec2::new(d.x * self.scale.x, -d.y * self.scale.y);
-        self.mipmap.lookup(self.filter, st, flip(ctx.duv_dx), flip(ctx.duv_dy))
+        self.mipmap.lookup(self.filter, st, self.image_step(ctx.duv_dx), self.image_step(ctx.duv_dy))
+    }
+
+    /// The continuous MIP level that [`ImageTexture::eval`] reads at the lookup.
+    pub fn lod(&self, ctx: &TexCtx) -> f32 {
+        self.mipmap.filter_lod(self.filter, self.image_step(ctx.duv_dx), self.image_step(ctx.duv_dy))
+    }
+
+    /// A uv step as a step in image coordinates (scaled, y down).
+    #[inline]
+    fn image_step(&self, d: Vec2) -> Vec2 {
+        Vec2::new(d.x * self.scale.x, -d.y * self.scale.y)
     }
 }
 
@@ -82,6 +97,8 @@ impl ImageTexture {
 pub enum Texture {
     /// An image.
     Image(ImageTexture),
+    /// Tiling and blending of an exemplar, optionally deformed (paper 000).
+    TilingBlending(TilingBlending),
 }
 
 impl Texture {
@@ -90,18 +107,42 @@ impl Texture {
     pub fn eval(&self, ctx: &TexCtx) -> Vec4 {
         match self {
             Texture::Image(t) => t.eval(ctx),
+            Texture::TilingBlending(t) => t.eval(ctx),
+        }
+    }
+
+    /// A tangent-space normal map's unit normal at the lookup, in the frame whose x axis is
+    /// [`Texture::tangent_direction`] (or dp/du without one). Images decode n = 2 rgb - 1;
+    /// tiling and blending blends the tiles' slopes.
+    pub fn eval_normal(&self, ctx: &TexCtx) -> Option<Vec3> {
+        match self {
+            Texture::TilingBlending(t) => t.eval_normal(ctx),
+            _ => (self.eval(ctx).truncate() * 2.0 - Vec3::ONE).try_normalize(),
+        }
+    }
+
+    /// Where a deformation field orients the texture: the UV direction of the texture's own x
+    /// axis at `uv` and whether the field reverses orientation (DESIGN.md section 3).
+    pub fn tangent_direction(&self, uv: Vec2) -> Option<(Vec2, bool)> {
+        match self {
+            Texture::TilingBlending(t) => t.tangent_direction(uv),
+            _ => None,
         }
     }
 
     /// True when lookups use the footprint (a filtered image), so hits must compute it.
     pub fn uses_footprint(&self) -> bool {
-        matches!(self, Texture::Image(t) if t.filter != Filter::None)
+        match self {
+            Texture::Image(t) => t.filter != Filter::None,
+            Texture::TilingBlending(t) => t.uses_footprint(),
+        }
     }
 
     /// Approximate memory held, in bytes.
     pub fn memory_bytes(&self) -> usize {
         match self {
             Texture::Image(t) => t.mipmap.memory_bytes(),
+            Texture::TilingBlending(t) => t.memory_bytes(),
         }
     }
 }

@@ -1,0 +1,58 @@
+//! Evaluate a texture over the UV square into an image, with no light transport: for
+//! inspection, for comparisons with GPU shaders, and for exporting procedural textures.
+
+use super::{TexCtx, Texture};
+use crate::image::Bitmap;
+use glam::Vec2;
+use rayon::prelude::*;
+
+/// The footprint a bake gives each lookup.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BakeFootprint {
+    /// One texel of the bake (what a GPU shader drawing the UV square at that resolution sees).
+    #[default]
+    Texel,
+    /// Zero: point lookups (filtered textures read their finest level).
+    Point,
+}
+
+/// The RGBA texture over [0, 1]^2 at `res` x `res` texel centres. Row 0 is the top of the UV
+/// square (v near 1), as the texture conventions of DESIGN.md section 3 lay images out, so the
+/// bake of an image texture at the image's resolution with point lookups is the image itself.
+pub fn bake(texture: &Texture, res: usize, footprint: BakeFootprint) -> Bitmap {
+    let mut out = Bitmap::new(res, res, 4);
+    let step = match footprint {
+        BakeFootprint::Texel => 1.0 / res as f32,
+        BakeFootprint::Point => 0.0,
+    };
+    out.data.par_chunks_mut(res * 4).enumerate().for_each(|(row, line)| {
+        let v = (res - 1 - row) as f32 + 0.5;
+        for (col, px) in line.chunks_exact_mut(4).enumerate() {
+            let uv = Vec2::new(col as f32 + 0.5, v) / res as f32;
+            let ctx = TexCtx { uv, duv_dx: Vec2::new(step, 0.0), duv_dy: Vec2::new(0.0, step) };
+            px.copy_from_slice(&texture.eval(&ctx).to_array());
+        }
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::{Filter, ImageTexture, MipMap};
+
+    #[test]
+    fn baking_an_image_at_its_resolution_gives_the_image() {
+        let mut b = Bitmap::new(8, 8, 4);
+        for (i, v) in b.data.iter_mut().enumerate() {
+            *v = ((i * 37) % 11) as f32;
+        }
+        let tex = Texture::Image(ImageTexture {
+            mipmap: std::sync::Arc::new(MipMap::new(b.clone())),
+            filter: Filter::None,
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        });
+        assert_eq!(bake(&tex, 8, BakeFootprint::Point), b);
+    }
+}

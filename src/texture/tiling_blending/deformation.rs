@@ -1,0 +1,134 @@
+//! The deformation field F(u) of deformed tiling and blending (paper 000 Eq. 3): a 2x2 matrix
+//! at every point of the UV plane that maps UV offsets from a tile's centre to exemplar offsets.
+//!
+//! The texture's own axes appear in UV along the columns of F^-1: F = s I shows the pattern
+//! 1/s times as large, F = R(theta) shows it turned by -theta (DESIGN.md section 3).
+
+use crate::texture::MipMap;
+use glam::{Mat2, Vec2};
+
+/// One factor of a deformation field.
+#[derive(Clone, Debug)]
+pub enum Deformation {
+    /// The same matrix everywhere.
+    Constant(Mat2),
+    /// F = R(theta(u)), theta(u) = angle + gradient . u (radians).
+    Rotation {
+        /// Angle at uv = (0, 0), radians.
+        angle: f32,
+        /// Change of the angle per UV unit along u and v, radians.
+        gradient: Vec2,
+    },
+    /// F = diag(s(u)), s(u) = scale 2^(gradient . u).
+    Scale {
+        /// Scale along u and v at uv = (0, 0).
+        scale: Vec2,
+        /// Change of log2 of the scale per UV unit along u and v.
+        gradient: Vec2,
+    },
+    /// F = [[1, k(u)], [0, 1]], k(u) = shear + gradient . u: the exemplar's x offset grows with
+    /// the UV v offset.
+    Shear {
+        /// Shear at uv = (0, 0).
+        shear: f32,
+        /// Change of the shear per UV unit along u and v.
+        gradient: Vec2,
+    },
+    /// An F map: four channels (F00, F01, F10, F11, row-major), interpolated bilinearly between
+    /// texel centres with the texture conventions of DESIGN.md section 3 (bottom-left origin,
+    /// repeat).
+    Map(MipMap),
+}
+
+impl Deformation {
+    /// F at `uv`.
+    #[inline]
+    pub fn at(&self, uv: Vec2) -> Mat2 {
+        match self {
+            Deformation::Constant(m) => *m,
+            Deformation::Rotation { angle, gradient } => {
+                let (s, c) = (angle + gradient.dot(uv)).sin_cos();
+                Mat2::from_cols(Vec2::new(c, s), Vec2::new(-s, c))
+            }
+            Deformation::Scale { scale, gradient } => Mat2::from_diagonal(*scale * gradient.dot(uv).exp2()),
+            Deformation::Shear { shear, gradient } => {
+                Mat2::from_cols(Vec2::X, Vec2::new(shear + gradient.dot(uv), 1.0))
+            }
+            Deformation::Map(map) => {
+                let uv = uv - uv.floor();
+                let f = map.bilinear(0, Vec2::new(uv.x, 1.0 - uv.y));
+                Mat2::from_cols(Vec2::new(f.x, f.z), Vec2::new(f.y, f.w))
+            }
+        }
+    }
+}
+
+/// A deformation field: the product F = F_1 F_2 ... F_n of its factors (identity when empty).
+#[derive(Clone, Debug, Default)]
+pub struct DeformationField {
+    factors: Vec<Deformation>,
+}
+
+impl DeformationField {
+    /// The field F_1 F_2 ... F_n.
+    pub fn new(factors: Vec<Deformation>) -> Self {
+        DeformationField { factors }
+    }
+
+    /// F at `uv`.
+    #[inline]
+    pub fn at(&self, uv: Vec2) -> Mat2 {
+        match self.factors.as_slice() {
+            [] => Mat2::IDENTITY,
+            [only] => only.at(uv),
+            [first, rest @ ..] => rest.iter().fold(first.at(uv), |m, f| m * f.at(uv)),
+        }
+    }
+
+    /// Bytes held by F maps.
+    pub fn memory_bytes(&self) -> usize {
+        self.factors.iter().map(|f| if let Deformation::Map(m) = f { m.memory_bytes() } else { 0 }).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image::Bitmap;
+
+    #[test]
+    fn analytic_fields_have_their_documented_form() {
+        let uv = Vec2::new(0.3, 0.7);
+        let rot = Deformation::Rotation { angle: 0.1, gradient: Vec2::new(1.0, 0.5) }.at(uv);
+        let theta: f32 = 0.1 + 0.3 + 0.35;
+        assert!((rot * Vec2::X - Vec2::new(theta.cos(), theta.sin())).length() < 1e-6);
+        assert!((rot.determinant() - 1.0).abs() < 1e-6);
+        let scale = Deformation::Scale { scale: Vec2::new(2.0, 3.0), gradient: Vec2::new(1.0, 0.0) }.at(uv);
+        assert!((scale * Vec2::ONE - Vec2::new(2.0, 3.0) * 0.3f32.exp2()).length() < 1e-5);
+        let shear = Deformation::Shear { shear: 0.5, gradient: Vec2::new(0.0, 1.0) }.at(uv);
+        assert!((shear * Vec2::new(0.0, 1.0) - Vec2::new(1.2, 1.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn product_of_factors_in_order() {
+        let a = Mat2::from_cols_array(&[1.0, 2.0, 3.0, 4.0]);
+        let b = Mat2::from_cols_array(&[0.0, 1.0, -1.0, 0.0]);
+        let field = DeformationField::new(vec![Deformation::Constant(a), Deformation::Constant(b)]);
+        assert_eq!(field.at(Vec2::ZERO), a * b);
+        assert_eq!(DeformationField::default().at(Vec2::ONE), Mat2::IDENTITY);
+    }
+
+    #[test]
+    fn f_map_is_read_row_major_at_texel_centres() {
+        // 2x1 map: left texel F = [[1, 2], [3, 4]], right texel the identity.
+        let mut b = Bitmap::new(2, 1, 4);
+        b.data.copy_from_slice(&[1.0, 2.0, 3.0, 4.0, 1.0, 0.0, 0.0, 1.0]);
+        let field = Deformation::Map(MipMap::new(b));
+        let left = field.at(Vec2::new(0.25, 0.5));
+        assert_eq!(left * Vec2::X, Vec2::new(1.0, 3.0));
+        assert_eq!(left * Vec2::Y, Vec2::new(2.0, 4.0));
+        // Halfway between the two texel centres: the mean.
+        let mid = field.at(Vec2::new(0.5, 0.5));
+        assert!((mid * Vec2::Y - Vec2::new(1.0, 2.5)).length() < 1e-6);
+    }
+}
