@@ -5,7 +5,7 @@ use crate::bsdf::{Bsdf, Conductor, ConductorFresnel, Dielectric, Diffuse, Ggx, P
 use crate::color::Rgb;
 use crate::geometry::Frame;
 use crate::texture::{Channel, TexCtx, Texture};
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use std::sync::Arc;
 
 /// Index of a texture in the scene's texture list.
@@ -128,6 +128,14 @@ pub enum MaterialKind {
         metallic: FloatParam,
         /// glTF roughness; GGX alpha = roughness^2.
         roughness: FloatParam,
+        /// Factor on the diffuse base (ambient occlusion), in [0, 1].
+        occlusion: FloatParam,
+        /// Anisotropy strength in [0, 1] (KHR_materials_anisotropy): the metal lobe's alpha
+        /// along the anisotropy direction becomes mix(alpha, 1, strength^2).
+        anisotropy: FloatParam,
+        /// Tangent-space direction of the anisotropy: RG in [0, 1] encode (x, y) = 2 rg - 1 in
+        /// the shading frame (s, t); None is along s.
+        anisotropy_direction: Option<TextureId>,
         /// Interface albedos of IOR 1.5 over [`PlasticTables::alpha_grid`].
         tables: Arc<PlasticTables>,
     },
@@ -193,9 +201,16 @@ impl Material {
             MaterialKind::Plastic { diffuse_reflectance, specular_reflectance, .. } => {
                 vec![diffuse_reflectance.texture(), specular_reflectance.texture()]
             }
-            MaterialKind::Pbr { base_color, metallic, roughness, .. } => {
-                vec![base_color.texture(), metallic.texture(), roughness.texture()]
-            }
+            MaterialKind::Pbr {
+                base_color, metallic, roughness, occlusion, anisotropy, anisotropy_direction, ..
+            } => vec![
+                base_color.texture(),
+                metallic.texture(),
+                roughness.texture(),
+                occlusion.texture(),
+                anisotropy.texture(),
+                *anisotropy_direction,
+            ],
         };
         ids.into_iter().chain([self.normal_map]).flatten().collect()
     }
@@ -227,12 +242,16 @@ impl Material {
                     tables,
                 })
             }
-            MaterialKind::Pbr { base_color, metallic, roughness, tables } => {
+            MaterialKind::Pbr { base_color, metallic, roughness, occlusion, anisotropy, tables, .. } => {
                 let r = roughness.eval(textures, ctx).clamp(0.0, 1.0);
+                let alpha = r * r;
+                let strength = anisotropy.eval(textures, ctx).clamp(0.0, 1.0);
                 Bsdf::Pbr(Pbr {
                     base_color: base_color.eval(textures, ctx),
                     metallic: metallic.eval(textures, ctx).clamp(0.0, 1.0),
-                    alpha: r * r,
+                    alpha_u: alpha + (1.0 - alpha) * strength * strength,
+                    alpha_v: alpha,
+                    occlusion: occlusion.eval(textures, ctx).clamp(0.0, 1.0),
                     tables,
                 })
             }
@@ -243,13 +262,20 @@ impl Material {
     /// (mirrored already for a two-sided material seen from the back) and the position's
     /// derivatives `dpdu`, `dpdv`.
     ///
-    /// With a texture frame, s is first turned in the tangent plane to the texture's x axis.
-    /// With a normal map, the map's normal is read in that frame and the tangent s re-projected
+    /// With a texture frame, s is first turned in the tangent plane to the texture's x axis,
+    /// then to a `pbr` material's anisotropy direction. With a normal map, the map's normal is read in that frame and the tangent s re-projected
     /// onto its plane (Mitsuba's `normalmap`).
     pub fn shading(&self, textures: &[Texture], ctx: &TexCtx, base: Frame, dpdu: Vec3, dpdv: Vec3) -> Shading {
         let base = match self.texture_frame.and_then(|id| textures[id.0 as usize].tangent_direction(ctx.uv)) {
             Some((direction, reversed)) => base.turned_towards(dpdu * direction.x + dpdv * direction.y, reversed),
             None => base,
+        };
+        let base = match &self.kind {
+            MaterialKind::Pbr { anisotropy_direction: Some(id), .. } => {
+                let d = textures[id.0 as usize].eval(ctx) * 2.0 - Vec4::ONE;
+                base.turned_towards(base.s * d.x + base.t * d.y, false)
+            }
+            _ => base,
         };
         let plain = Shading { frame: base, base, bump_alpha2: None };
         let Some(id) = self.normal_map else { return plain };

@@ -66,10 +66,21 @@ fn configurations() -> Vec<(String, Bsdf<'static>)> {
             }),
         ),
     ];
+    v.push((
+        "pbr anisotropic metallic=0.7 alpha=(0.5, 0.08) occlusion=0.5".into(),
+        Bsdf::Pbr(Pbr {
+            base_color: Rgb::new(0.8, 0.6, 0.2),
+            metallic: 0.7,
+            alpha_u: 0.5,
+            alpha_v: 0.08,
+            occlusion: 0.5,
+            tables: pbr_tables,
+        }),
+    ));
     for metallic in [0.0, 0.4, 1.0] {
         v.push((
             format!("pbr metallic={metallic} roughness=0.6"),
-            Bsdf::Pbr(Pbr { base_color: Rgb::new(0.8, 0.6, 0.2), metallic, alpha: 0.36, tables: pbr_tables }),
+            Bsdf::Pbr(Pbr::isotropic(Rgb::new(0.8, 0.6, 0.2), metallic, 0.36, pbr_tables)),
         ));
     }
     v

@@ -111,9 +111,9 @@ fn rough_plastic_and_pbr_conserve_energy() {
             alpha: 0.1,
             tables: &plastic_tables,
         }),
-        Bsdf::Pbr(Pbr { base_color: Rgb::ONE, metallic: 0.0, alpha: 0.25, tables: &grid_tables }),
-        Bsdf::Pbr(Pbr { base_color: Rgb::ONE, metallic: 1.0, alpha: 0.25, tables: &grid_tables }),
-        Bsdf::Pbr(Pbr { base_color: Rgb::ONE, metallic: 0.5, alpha: 0.6, tables: &grid_tables }),
+        Bsdf::Pbr(Pbr::isotropic(Rgb::ONE, 0.0, 0.25, &grid_tables)),
+        Bsdf::Pbr(Pbr::isotropic(Rgb::ONE, 1.0, 0.25, &grid_tables)),
+        Bsdf::Pbr(Pbr::isotropic(Rgb::ONE, 0.5, 0.6, &grid_tables)),
     ];
     for b in &models {
         for wo in views() {
@@ -138,7 +138,7 @@ fn reflection_models_are_reciprocal() {
             alpha: 0.3,
             tables: &plastic_tables,
         }),
-        Bsdf::Pbr(Pbr { base_color: Rgb::new(0.9, 0.5, 0.2), metallic: 0.3, alpha: 0.2, tables: &grid_tables }),
+        Bsdf::Pbr(Pbr::isotropic(Rgb::new(0.9, 0.5, 0.2), 0.3, 0.2, &grid_tables)),
     ];
     for b in &models {
         for i in 0..2000u32 {

@@ -62,7 +62,14 @@ fn image_texture(n: usize, values: Vec<f32>, filter: Filter) -> Arc<Texture> {
 }
 
 fn synthesis(tiling: Tiling, blend: Blend, deformation: Option<Vec<Deformation>>) -> Arc<Synthesis> {
-    Arc::new(Synthesis { tiling, tile_size: 0.25, seed: 3, deformation: deformation.map(DeformationField::new), blend })
+    Arc::new(Synthesis {
+        tiling,
+        tile_size: 0.25,
+        seed: 3,
+        deformation: deformation.map(DeformationField::new),
+        blend,
+        inset: false,
+    })
 }
 
 fn tb(synthesis: &Arc<Synthesis>, exemplar: &Arc<Texture>) -> Texture {
@@ -100,13 +107,21 @@ fn identity_deformation_is_classical_tiling_and_blending_exactly() {
     let exemplar = image_texture(64, gaussian_field(64, 2.0, 1), Filter::Trilinear);
     for tiling in [Tiling::Hexagonal, Tiling::Square] {
         for blend in all_blends(&exemplar) {
-            let classical = tb(&synthesis(tiling, blend.clone(), None), &exemplar);
-            let identity =
-                tb(&synthesis(tiling, blend.clone(), Some(vec![Deformation::Constant(Mat2::IDENTITY)])), &exemplar);
-            for footprint in [BakeFootprint::Texel, BakeFootprint::Point] {
-                let (a, b) = (bake(&classical, 96, footprint), bake(&identity, 96, footprint));
-                assert!(a.data == b.data, "{tiling:?} {blend:?} {footprint:?}: F = I differs from classical T&B");
+            for inset in [false, true] {
+                let mut classical = synthesis(tiling, blend.clone(), None);
+                let mut identity = synthesis(tiling, blend.clone(), Some(vec![Deformation::Constant(Mat2::IDENTITY)]));
+                Arc::make_mut(&mut classical).inset = inset;
+                Arc::make_mut(&mut identity).inset = inset;
+                let (classical, identity) = (tb(&classical, &exemplar), tb(&identity, &exemplar));
+                for footprint in [BakeFootprint::Texel, BakeFootprint::Point] {
+                    let (a, b) = (bake(&classical, 96, footprint), bake(&identity, 96, footprint));
+                    assert!(
+                        a.data == b.data,
+                        "{tiling:?} {blend:?} {footprint:?} inset {inset}: F = I is not classical"
+                    );
+                }
             }
+            let classical = tb(&synthesis(tiling, blend.clone(), None), &exemplar);
             // And a deformation does change it.
             let rotated =
                 tb(&synthesis(tiling, blend, Some(vec![Deformation::Constant(Mat2::from_angle(0.5))])), &exemplar);
@@ -305,6 +320,7 @@ fn footprint_is_f_times_the_pixel_footprint_as_finite_differences_say() {
             seed: 1,
             deformation: Some(DeformationField::new(vec![field])),
             blend: Blend::Linear,
+            inset: false,
         };
         for i in 0..500 {
             let uv = Sampler::new(2, i, 0).next_2d() * 4.0;
@@ -422,4 +438,101 @@ fn bake_rows_follow_the_uv_convention() {
     assert_eq!(baked.pixel(0, 0), Vec4::new(1.0, 1.0, 1.0, 1.0));
     let top_left = image.eval(&TexCtx { uv: Vec2::new(0.125, 0.875), ..Default::default() });
     assert_eq!(top_left.x, 1.0);
+}
+
+#[test]
+fn deformation_orients_the_shading_frame_along_the_texture() {
+    use glam::Vec3;
+    use tessera::color::Rgb;
+    use tessera::geometry::Frame;
+    use tessera::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
+    // The texture's x axis lies along F^-1 e1 in UV, so on a surface with dp/du = 2 x and
+    // dp/dv = y along J F^-1 e1; a mirroring F reverses t.
+    let exemplar = image_texture(8, vec![0.3; 64], Filter::None);
+    let theta = 0.4f32;
+    for (f, reversed) in
+        [(Mat2::from_angle(theta), false), (Mat2::from_angle(theta) * Mat2::from_diagonal(Vec2::new(1.0, -1.0)), true)]
+    {
+        let textures =
+            vec![tb(&synthesis(Tiling::Hexagonal, Blend::Linear, Some(vec![Deformation::Constant(f)])), &exemplar)];
+        let alpha = FloatParam::Texture { id: TextureId(0), channel: tessera::texture::Channel::R, scale: 1.0 };
+        let material = Material {
+            kind: MaterialKind::Conductor {
+                roughness: Some(Roughness { alpha_u: alpha, alpha_v: FloatParam::Value(0.05) }),
+                eta: Rgb::ZERO,
+                k: Rgb::ONE,
+                specular_reflectance: ColorParam::Value(Rgb::ONE),
+            },
+            normal_map: None,
+            two_sided: false,
+            texture_frame: Some(TextureId(0)),
+        };
+        let base = Frame { s: Vec3::X, t: Vec3::Y, n: Vec3::Z };
+        let ctx = TexCtx { uv: Vec2::new(0.3, 0.6), ..Default::default() };
+        let shading = material.shading(&textures, &ctx, base, Vec3::new(2.0, 0.0, 0.0), Vec3::Y);
+        // J F^-1 e1 with J = [dp/du dp/dv].
+        let along = f.inverse() * Vec2::X;
+        let expected = Vec3::new(2.0 * along.x, along.y, 0.0).normalize();
+        assert!(shading.frame.s.distance(expected) < 1e-5, "s = {} vs {expected}", shading.frame.s);
+        assert_eq!(shading.frame.n, Vec3::Z);
+        let t = Vec3::Z.cross(expected);
+        let t = if reversed { -t } else { t };
+        assert!(shading.frame.t.distance(t) < 1e-5, "t = {} (reversed {reversed})", shading.frame.t);
+    }
+}
+
+#[test]
+fn a_material_mixing_deformation_fields_is_refused() {
+    let toml = "[camera]\nfov = 30\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n\
+        [textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
+        [textures.a]\ntype = \"tiling_blending\"\nexemplar = \"e\"\ndeformation = [{ type = \"rotation\", angle = 10 }]\n\
+        [textures.b]\ntype = \"tiling_blending\"\nexemplar = \"e\"\ndeformation = [{ type = \"rotation\", angle = 20 }]\n\
+        [textures.c]\ntype = \"tiling_blending\"\nexemplar = \"e\"\nlayer_of = \"a\"\n\
+        [materials.ok]\ntype = \"pbr\"\nbase_color = \"a\"\nroughness = \"c\"\n\
+        [materials.bad]\ntype = \"pbr\"\nbase_color = \"a\"\nroughness = \"b\"\n\
+        [[shapes]]\ntype = \"rectangle\"\nmaterial = \"ok\"\n";
+    let mut png = Vec::new();
+    image::GrayImage::from_pixel(4, 4, image::Luma([100]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let dir = common::scene_dir(toml, &[("e.png", &png)]);
+    let Err(err) = common::load(dir.path()) else { panic!("a material mixing two deformation fields loaded") };
+    let err = err.to_string();
+    assert!(err.contains("materials.bad") && err.contains("layer_of"), "{err}");
+    let ok = common::scene_dir(&toml.replace("roughness = \"b\"", "roughness = \"c\""), &[("e.png", &png)]);
+    let scene = common::load(ok.path()).unwrap();
+    assert!(scene.materials.iter().all(|m| m.texture_frame.is_some()));
+}
+
+#[test]
+fn inset_shifts_keep_tiles_inside_a_non_tileable_exemplar() {
+    for (tiling, f) in [
+        (Tiling::Hexagonal, Mat2::IDENTITY),
+        (Tiling::Square, Mat2::IDENTITY),
+        (Tiling::Hexagonal, Mat2::from_cols_array(&[0.8, 0.3, -0.5, 1.1])),
+    ] {
+        let s = Synthesis {
+            tiling,
+            tile_size: 0.2,
+            seed: 5,
+            deformation: Some(DeformationField::new(vec![Deformation::Constant(f)])),
+            blend: Blend::Linear,
+            inset: true,
+        };
+        let mut lo = Vec2::ONE;
+        let mut hi = Vec2::ZERO;
+        for i in 0..20_000 {
+            let uv = Sampler::new(4, i, 0).next_2d() * 10.0 - 5.0;
+            for l in s.lookups(&TexCtx { uv, ..Default::default() }).iter().take(s.tiles_per_point()) {
+                lo = lo.min(l.ctx.uv);
+                hi = hi.max(l.ctx.uv);
+            }
+        }
+        assert!(
+            lo.cmpge(Vec2::splat(-1e-5)).all() && hi.cmple(Vec2::splat(1.0 + 1e-5)).all(),
+            "{tiling:?}: {lo} .. {hi}"
+        );
+        // And the shifts still spread over the exemplar.
+        assert!(lo.max_element() < 0.05 && hi.min_element() > 0.95, "{tiling:?}: {lo} .. {hi}");
+    }
 }

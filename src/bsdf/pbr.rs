@@ -1,6 +1,10 @@
 //! glTF 2.0 metallic-roughness as a BSDF: a blend, by `metallic`, of a GGX conductor whose
 //! Fresnel is Schlick's with F0 = base colour, and a rough plastic (IOR 1.5) whose diffuse base
-//! has the base colour. Both lobes share the roughness alpha = roughness^2.
+//! has the base colour. Both lobes share the roughness alpha = roughness^2. Anisotropy (as
+//! KHR_materials_anisotropy: alpha along the direction mix(alpha, 1, strength^2), alpha across
+//! it) shapes the metal lobe; the dielectric lobe, whose tables are isotropic, takes the
+//! geometric mean of the two. An occlusion factor darkens the diffuse base only (a cavity term
+//! for detail below the geometry; path tracing computes the rest of the occlusion).
 
 use super::{BsdfSample, Conductor, ConductorFresnel, Ggx, Plastic, PlasticTables};
 use crate::color::Rgb;
@@ -13,16 +17,25 @@ pub struct Pbr<'a> {
     pub base_color: Rgb,
     /// Metalness in [0, 1].
     pub metallic: f32,
-    /// GGX alpha (roughness squared).
-    pub alpha: f32,
+    /// GGX alpha of the metal lobe along the shading frame's s (the anisotropy direction).
+    pub alpha_u: f32,
+    /// GGX alpha of the metal lobe along t.
+    pub alpha_v: f32,
+    /// Factor on the diffuse base's albedo (ambient occlusion map), in [0, 1].
+    pub occlusion: f32,
     /// Interface albedos of the IOR-1.5 coating over the alpha grid.
     pub tables: &'a PlasticTables,
 }
 
-impl Pbr<'_> {
+impl<'a> Pbr<'a> {
+    /// The isotropic model of glTF's core metallic-roughness, without occlusion.
+    pub fn isotropic(base_color: Rgb, metallic: f32, alpha: f32, tables: &'a PlasticTables) -> Self {
+        Pbr { base_color, metallic, alpha_u: alpha, alpha_v: alpha, occlusion: 1.0, tables }
+    }
+
     fn metal(&self) -> Conductor {
         Conductor {
-            ggx: Some(Ggx::new(self.alpha, self.alpha)),
+            ggx: Some(Ggx::new(self.alpha_u, self.alpha_v)),
             fresnel: ConductorFresnel::Schlick { f0: self.base_color },
             specular_reflectance: Rgb::ONE,
         }
@@ -30,9 +43,9 @@ impl Pbr<'_> {
 
     fn dielectric(&self) -> Plastic<'_> {
         Plastic {
-            diffuse_reflectance: self.base_color,
+            diffuse_reflectance: self.base_color * self.occlusion,
             specular_reflectance: Rgb::ONE,
-            alpha: self.alpha,
+            alpha: (self.alpha_u * self.alpha_v).sqrt(),
             tables: self.tables,
         }
     }

@@ -146,6 +146,9 @@ pub struct TilingBlendingDesc {
     pub tile_size: Option<f32>,
     /// Seed of the tiles' shifts (default 0).
     pub seed: Option<u64>,
+    /// Whether the exemplar tiles (default true): if false, each tile's shift keeps it inside
+    /// the exemplar where it fits, so that its borders never show.
+    pub tileable: Option<bool>,
     /// Blending operator (default `linear`).
     pub blend: Option<BlendKind>,
     /// `sharpened`: power on the paving's weights (default 7).
@@ -313,6 +316,13 @@ pub enum MaterialDesc {
         metallic: Option<FloatValue>,
         /// glTF roughness (default 1); alpha = roughness^2.
         roughness: Option<FloatValue>,
+        /// Factor on the diffuse base, an ambient-occlusion map (default 1).
+        occlusion: Option<FloatValue>,
+        /// Anisotropy strength in [0, 1] (default 0): alpha along the anisotropy direction is
+        /// mix(alpha, 1, strength^2).
+        anisotropy: Option<FloatValue>,
+        /// Texture whose RG encode the anisotropy direction (2 rg - 1) in the shading frame.
+        anisotropy_direction: Option<String>,
         /// Scatter from the back side as from the front.
         #[serde(default)]
         two_sided: bool,

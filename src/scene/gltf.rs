@@ -168,7 +168,15 @@ fn convert_material(
         warnings.push(format!("material '{name}': alpha mode {:?} ignored (rendered opaque)", m.alpha_mode()));
     }
     Material {
-        kind: MaterialKind::Pbr { base_color, metallic, roughness, tables },
+        kind: MaterialKind::Pbr {
+            base_color,
+            metallic,
+            roughness,
+            occlusion: FloatParam::Value(1.0),
+            anisotropy: FloatParam::Value(0.0),
+            anisotropy_direction: None,
+            tables,
+        },
         normal_map,
         two_sided: m.double_sided(),
         texture_frame: None,

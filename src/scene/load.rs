@@ -323,6 +323,7 @@ impl<'a> Loader<'a> {
                 ("tiling", d.tiling.is_some()),
                 ("tile_size", d.tile_size.is_some()),
                 ("seed", d.seed.is_some()),
+                ("tileable", d.tileable.is_some()),
                 ("blend", d.blend.is_some()),
                 ("exponent", d.exponent.is_some()),
                 ("luminance_contrast", d.luminance_contrast.is_some()),
@@ -415,6 +416,7 @@ impl<'a> Loader<'a> {
             seed: d.seed.unwrap_or(0),
             deformation,
             blend,
+            inset: !d.tileable.unwrap_or(true),
         });
         self.syntheses.insert(name.to_string(), synthesis.clone());
         Ok(synthesis)
@@ -642,7 +644,16 @@ impl<'a> Loader<'a> {
                     *two_sided,
                 )
             }
-            MaterialDesc::Pbr { base_color, metallic, roughness, two_sided, normal_map } => {
+            MaterialDesc::Pbr {
+                base_color,
+                metallic,
+                roughness,
+                occlusion,
+                anisotropy,
+                anisotropy_direction,
+                two_sided,
+                normal_map,
+            } => {
                 let unit = |x: f32| (0.0..=1.0).contains(&x);
                 let base_color = self.color(base_color.as_ref(), 1.0, &format!("{item}.base_color"))?;
                 let metallic = self.float(
@@ -657,7 +668,32 @@ impl<'a> Loader<'a> {
                     unit,
                     "in [0, 1]",
                 )?;
-                (MaterialKind::Pbr { base_color, metallic, roughness, tables: pbr_tables() }, normal_map, *two_sided)
+                let occlusion = self.float(
+                    occlusion.as_ref().unwrap_or(&FloatValue::Value(1.0)),
+                    &format!("{item}.occlusion"),
+                    unit,
+                    "in [0, 1]",
+                )?;
+                let anisotropy = self.float(
+                    anisotropy.as_ref().unwrap_or(&FloatValue::Value(0.0)),
+                    &format!("{item}.anisotropy"),
+                    unit,
+                    "in [0, 1]",
+                )?;
+                let anisotropy_direction = anisotropy_direction
+                    .as_ref()
+                    .map(|n| self.texture(n, Role::Data, &format!("{item}.anisotropy_direction")))
+                    .transpose()?;
+                let kind = MaterialKind::Pbr {
+                    base_color,
+                    metallic,
+                    roughness,
+                    occlusion,
+                    anisotropy,
+                    anisotropy_direction,
+                    tables: pbr_tables(),
+                };
+                (kind, normal_map, *two_sided)
             }
         };
         let normal_map = self.normal_map(normal_map, item)?;

@@ -116,6 +116,11 @@ pub struct Synthesis {
     pub deformation: Option<DeformationField>,
     /// The blending operator.
     pub blend: Blend,
+    /// Keep each tile inside the exemplar's unit square where it fits (for exemplars that do
+    /// not tile): the shift of tile i is drawn, per axis, in [r_i, 1 - r_i], r_i the tile's
+    /// reach in the exemplar (its support's extent through F at its centre). Otherwise shifts
+    /// are uniform over the square and lookups wrap around it.
+    pub inset: bool,
 }
 
 /// One tile's lookup into the exemplar and its paving weight.
@@ -149,7 +154,10 @@ impl Synthesis {
         let mut out = [TileLookup::default(); MAX_TILES];
         for (out, tile) in out.iter_mut().zip(&tiles).take(self.tiles_per_point()) {
             let offset = ctx.uv - tile.centre;
-            let h = shift(tile.vertex, self.seed);
+            let mut h = shift(tile.vertex, self.seed);
+            if self.inset {
+                h = self.inset_shift(h, tile.centre);
+            }
             out.weight = tile.weight;
             out.ctx = match f {
                 None => TexCtx { uv: offset + h, ..*ctx },
@@ -157,6 +165,20 @@ impl Synthesis {
             };
         }
         out
+    }
+
+    /// A shift `h` uniform over the exemplar's square narrowed, along each axis where the tile
+    /// fits, to the positions that keep the tile (its support's corners through F at its
+    /// centre) inside the square.
+    fn inset_shift(&self, h: Vec2, centre: Vec2) -> Vec2 {
+        let f = self.deformation_at(centre);
+        let reach = self
+            .tiling
+            .support_corners()
+            .iter()
+            .fold(Vec2::ZERO, |r, corner| r.max((f * (*corner * self.tile_size)).abs()));
+        let narrowed = reach + h * (Vec2::ONE - 2.0 * reach);
+        Vec2::select(reach.cmplt(Vec2::splat(0.5)), narrowed, h)
     }
 
     /// The blending weights of the tiles: the paving's for the linear and variance-preserving

@@ -44,6 +44,26 @@ impl Tiling {
         }
     }
 
+    /// The corners of a tile's support (it is their convex hull) relative to its centre, for a
+    /// unit lattice spacing: the hexagon of the six neighbouring vertices, or the square of
+    /// half-side 1.
+    pub fn support_corners(self) -> &'static [Vec2] {
+        const HEXAGON: [Vec2; 6] = [
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.5, ROW_HEIGHT),
+            Vec2::new(-0.5, ROW_HEIGHT),
+            Vec2::new(-1.0, 0.0),
+            Vec2::new(-0.5, -ROW_HEIGHT),
+            Vec2::new(0.5, -ROW_HEIGHT),
+        ];
+        const SQUARE: [Vec2; 4] =
+            [Vec2::new(1.0, 1.0), Vec2::new(-1.0, 1.0), Vec2::new(-1.0, -1.0), Vec2::new(1.0, -1.0)];
+        match self {
+            Tiling::Hexagonal => &HEXAGON,
+            Tiling::Square => &SQUARE,
+        }
+    }
+
     /// The tiles covering `uv` for lattice spacing `size`; the first
     /// [`Tiling::tiles_per_point`] entries are valid.
     #[inline]
@@ -153,7 +173,7 @@ mod tests {
                     let w = at_centre.iter().find(|o| o.vertex == t.vertex).map_or(0.0, |o| o.weight);
                     assert!(w > 0.999, "{tiling:?}: {w}");
                     // Every covering tile's centre is within the support radius.
-                    let radius = if tiling == Tiling::Hexagonal { 1.0 } else { std::f32::consts::SQRT_2 };
+                    let radius = tiling.support_corners().iter().map(|c| c.length()).fold(0.0, f32::max);
                     assert!((uv - t.centre).length() <= radius * size * 1.0001);
                 }
             }
