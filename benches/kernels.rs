@@ -57,10 +57,7 @@ fn bsdf(c: &mut Criterion) {
                 specular_reflectance: Rgb::ONE,
             }),
         ),
-        (
-            "pbr",
-            Bsdf::Pbr(tessera::bsdf::Pbr { base_color: Rgb::splat(0.7), metallic: 0.5, alpha: 0.2, tables: &tables }),
-        ),
+        ("pbr", Bsdf::Pbr(tessera::bsdf::Pbr::isotropic(Rgb::splat(0.7), 0.5, 0.2, &tables))),
     ];
     let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
     for (name, b) in &models {

@@ -223,3 +223,112 @@ fn cli_renders_crop_and_aovs() {
     let img = tessera::image::read_bitmap(&out, tessera::image::ColorSpace::Linear).unwrap();
     assert_eq!((img.width, img.height), (8, 4));
 }
+
+#[test]
+fn bad_tiling_and_blending_textures_are_named() {
+    let png = {
+        let mut bytes = Vec::new();
+        image::GrayImage::from_pixel(4, 4, image::Luma([90]))
+            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+            .unwrap();
+        bytes
+    };
+    let three_channel_exr = {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("f.exr");
+        let plane = vec![1.0f32; 4];
+        tessera::image::write_exr(
+            &p,
+            2,
+            2,
+            vec![("R".into(), plane.clone()), ("G".into(), plane.clone()), ("B".into(), plane)],
+        )
+        .unwrap();
+        std::fs::read(&p).unwrap()
+    };
+    let files: &[(&str, &[u8])] = &[("e.png", &png), ("f.exr", &three_channel_exr)];
+    let with = |tb: &str, extra: &str| {
+        format!(
+            "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n{extra}\
+             [textures.tb]\ntype = \"tiling_blending\"\n{tb}\n\
+             [materials.m]\ntype = \"diffuse\"\nreflectance = \"tb\"\n[[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\n"
+        )
+    };
+    error_of(&with("exemplar = \"nope\"", ""), files, &["textures.tb.exemplar", "unknown texture 'nope'"]);
+    error_of(&with("exemplar = \"tb\"", ""), files, &["textures.tb", "refers to itself"]);
+    error_of(&with("exemplar = \"e\"\ntile_size = 0", ""), files, &["textures.tb.tile_size"]);
+    error_of(&with("exemplar = \"e\"\nblend = \"mix_max\"", ""), files, &["textures.tb", "priority"]);
+    error_of(&with("exemplar = \"e\"\nexponent = 3", ""), files, &["textures.tb.exponent", "sharpened"]);
+    error_of(&with("exemplar = \"e\"\nblend = \"sharpened\"\nexponent = -1", ""), files, &["textures.tb.exponent"]);
+    error_of(&with("exemplar = \"e\"\nblend = \"mix_max\"\npriority = \"e\"\nlambda = nan", ""), files, &["lambda"]);
+    error_of(
+        &with("exemplar = \"e\"\nlayer_of = \"e\"", ""),
+        files,
+        &["textures.tb.layer_of", "not a tiling_blending"],
+    );
+    error_of(
+        &with(
+            "exemplar = \"e\"\nlayer_of = \"a\"\nseed = 3",
+            "[textures.a]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n",
+        ),
+        files,
+        &["textures.tb", "seed", "layer_of"],
+    );
+    error_of(
+        &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"f.exr\" }]", ""),
+        files,
+        &["f.exr", "4 channels", "textures.tb.deformation[0]"],
+    );
+    error_of(
+        &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"none.exr\" }]", ""),
+        files,
+        &["none.exr", "textures.tb.deformation[0]"],
+    );
+    error_of(
+        &with("exemplar = \"e\"\ndeformation = [{ type = \"scale\", scale = 0 }]", ""),
+        files,
+        &["deformation[0]", "non-zero"],
+    );
+    error_of(&with("exemplar = \"e\"\ndeformation = [{ type = \"twist\" }]", ""), files, &["unknown variant `twist`"]);
+    error_of(
+        &with(
+            "exemplar = \"inner\"\nblend = \"histogram_preserving\"",
+            "[textures.inner]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n",
+        ),
+        files,
+        &["textures.tb", "image exemplar"],
+    );
+}
+
+#[test]
+fn cli_bake_names_unknown_textures_and_writes_images() {
+    let dir = scene_dir(
+        &format!(
+            "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
+             [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n"
+        ),
+        &[("e.png", &{
+            let mut bytes = Vec::new();
+            image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))
+                .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+                .unwrap();
+            bytes
+        })],
+    );
+    let scene = dir.path().join("scene.toml");
+    let missing = tessera()
+        .arg("bake")
+        .arg(&scene)
+        .args(["--texture", "nope", "-o"])
+        .arg(dir.path().join("a.exr"))
+        .output()
+        .unwrap();
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("unknown texture 'nope'"));
+    let out = dir.path().join("tb.exr");
+    let ok =
+        tessera().arg("bake").arg(&scene).args(["--texture", "tb", "--res", "16", "-o"]).arg(&out).output().unwrap();
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let image = tessera::image::read_bitmap(&out, tessera::image::ColorSpace::Linear).unwrap();
+    assert_eq!((image.width, image.height, image.channels), (16, 16, 4));
+}

@@ -164,3 +164,27 @@ fn pbr_materials_are_not_exported_silently() {
     let err = export_mitsuba(&scene, &dir.path().join("out"), 256).unwrap_err().to_string();
     assert!(err.contains("material 0") && err.contains("no exact Mitsuba 3 equivalent"), "{err}");
 }
+
+#[test]
+fn procedural_textures_are_baked_over_the_uv_square() {
+    // The Fig. 2 rotation scene: its tiling-and-blending reflectance becomes a bitmap holding
+    // exactly tessera's point lookups at the bake's texel centres, with the identity uv map.
+    let path = common::repo().join("scenes/fig2_rotation.toml");
+    let scene = load_scene(&path, &SceneOverrides::default()).unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let export = export_mitsuba(&scene, out.path(), 64).unwrap();
+    assert!(export.warnings.iter().any(|w| w.contains("procedural")), "{:?}", export.warnings);
+    let xml = std::fs::read_to_string(out.path().join("scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let bitmap = doc.descendants().find(|n| n.attribute("type") == Some("bitmap")).expect("a bitmap texture");
+    let file = attr(bitmap, "filename").unwrap();
+    let baked = read_bitmap(&out.path().join(file), ColorSpace::Linear).unwrap();
+    assert_eq!((baked.width, baked.height), (64, 64));
+    let expected = tessera::texture::bake(&scene.textures[0], 64, tessera::texture::BakeFootprint::Point);
+    for (y, x) in [(0, 0), (5, 40), (63, 63), (31, 7)] {
+        let (a, b) = (baked.pixel(x, y).truncate(), expected.pixel(x, y).truncate());
+        assert!((a - b).abs().max_element() < 1e-6, "texel ({x}, {y}): {a} vs {b}");
+    }
+    let scale = bitmap.descendants().find(|n| n.has_tag_name("scale")).unwrap();
+    assert_eq!((scale.attribute("x"), scale.attribute("y")), (Some("1"), Some("1")));
+}

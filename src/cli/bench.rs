@@ -6,17 +6,27 @@
 //!   rays (cosine-distributed bounces from the primary hits), on one thread and on all.
 //! - A full render of `scenes/brushed_metal.toml` (Mitsuba scene A: 512 x 512, 64 spp, max
 //!   depth 8): samples per second, against Mitsuba 3's figures measured on this kind of machine.
+//! - Texture lookups on one thread, all on the same exemplar (`scenes/textures/bark.jpg`,
+//!   trilinear) and the same 1M lookups (a raster in scanline order, random footprints): the bitmap itself, classical
+//!   tiling and blending, and deformed tiling and blending with a 256 x 256 F map, for the
+//!   linear and Mix-Max operators; printed as lookups per second and as cost ratios to the bitmap
+//!   measured in the same run.
 
+use glam::{Mat2, Vec2};
 use rayon::prelude::*;
 use std::path::Path;
+use std::sync::Arc;
 use std::time::Instant;
 use tessera::accel::Accel;
 use tessera::camera::{FovAxis, PerspectiveCamera};
 use tessera::error::{Error, Result};
 use tessera::geometry::{Frame, Ray, offset_ray_origin, shapes};
+use tessera::image::{Bitmap, ColorSpace, read_bitmap};
 use tessera::integrator::render;
 use tessera::sampling::{Sampler, warp};
 use tessera::scene::{SceneOverrides, load_scene};
+use tessera::texture::tiling_blending::{Blend, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
+use tessera::texture::{Filter, ImageTexture, MipMap, TexCtx, Texture, TilingBlending};
 
 /// Mitsuba 3.9.1 on scene A, 512 x 512 at 64 spp on 2 cores (`../shared/tools/mitsuba/README.md`).
 const MITSUBA_LLVM_MSAMPLES: f64 = 5.0;
@@ -50,14 +60,39 @@ fn rays_per_second(runs: usize, rays: &[Ray], f: impl Fn(&[Ray]) -> usize) -> (f
     (median(rates), hits)
 }
 
-/// Run the benchmarks and print a table. `scene_dir` holds the shipped scenes.
-pub fn run(scene_dir: &Path, runs: usize, threads: usize) -> Result<()> {
+/// Which figures `tessera bench` measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Suite {
+    /// Ray casting throughput.
+    Rays,
+    /// The full render of scene A.
+    Render,
+    /// Texture lookups: bitmap, classical and deformed tiling and blending.
+    Textures,
+}
+
+/// Run the benchmarks of `suites` and print a table. `scene_dir` holds the shipped scenes.
+pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> Result<()> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| Error::param("--threads", e.to_string()))?;
     let threads = pool.current_num_threads();
     println!("tessera bench: medians of {runs} runs, {threads} threads where parallel");
+    if suites.contains(&Suite::Rays) {
+        rays(runs, &pool)?;
+    }
+    if suites.contains(&Suite::Render) {
+        render_scene_a(scene_dir, runs, &pool)?;
+    }
+    if suites.contains(&Suite::Textures) {
+        textures(scene_dir, runs)?;
+    }
+    Ok(())
+}
+
+fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
+    let threads = pool.current_num_threads();
 
     let tris = folded_sphere();
     let start = Instant::now();
@@ -97,7 +132,11 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize) -> Result<()> {
             100.0 * hits as f64 / rays.len() as f64
         );
     }
+    Ok(())
+}
 
+fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
+    let threads = pool.current_num_threads();
     let scene_path = scene_dir.join("brushed_metal.toml");
     let scene = load_scene(&scene_path, &SceneOverrides::default())?;
     let s = scene.settings;
@@ -122,5 +161,84 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize) -> Result<()> {
         rate / MITSUBA_LLVM_MSAMPLES,
         rate / MITSUBA_SCALAR_MSAMPLES
     );
+    Ok(())
+}
+
+/// Lookups per second (millions) of `texture` over `lookups`, median of `runs`.
+fn lookups_per_second(runs: usize, texture: &Texture, lookups: &[TexCtx]) -> f64 {
+    median(
+        (0..runs)
+            .map(|_| {
+                let start = Instant::now();
+                let sum: f32 = lookups.iter().map(|ctx| texture.eval(std::hint::black_box(ctx)).x).sum();
+                std::hint::black_box(sum);
+                lookups.len() as f64 / start.elapsed().as_secs_f64() / 1e6
+            })
+            .collect(),
+    )
+}
+
+fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
+    let file = scene_dir.join("textures/bark.jpg");
+    let exemplar = Arc::new(Texture::Image(ImageTexture {
+        mipmap: Arc::new(MipMap::new(read_bitmap(&file, ColorSpace::Srgb)?)),
+        filter: Filter::Trilinear,
+        scale: Vec2::ONE,
+        offset: Vec2::ZERO,
+    }));
+    let Texture::Image(image) = exemplar.as_ref() else { unreachable!("built as an image") };
+    // An F map of a smooth rotation-and-scale field, as `tessera deform` would write one.
+    let n = 256;
+    let mut map = Bitmap::new(n, n, 4);
+    for (i, px) in map.data.chunks_exact_mut(4).enumerate() {
+        let (x, y) = ((i % n) as f32 / n as f32, (i / n) as f32 / n as f32);
+        let f = Mat2::from_angle(3.0 * x + y);
+        px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
+    }
+    let deformation = DeformationField::new(vec![Deformation::Map(MipMap::new(map))]);
+    // The points of a 1024 x 1024 raster over 4 x 4 UV units, in scanline order as a render
+    // reaches them, each with a footprint 1/4 to 4 raster steps wide in any direction.
+    let lookups: Vec<TexCtx> = (0..1024 * 1024)
+        .map(|i| {
+            let mut s = Sampler::new(7, i, 0);
+            let uv = (Vec2::new((i % 1024) as f32, (i / 1024) as f32) + s.next_2d()) * (4.0 / 1024.0);
+            let width = (4.0 / 1024.0) * 0.25 * 16f32.powf(s.next_1d());
+            let dx = Vec2::from_angle(s.next_1d() * std::f32::consts::TAU) * width;
+            TexCtx { uv, duv_dx: dx, duv_dy: dx.perp() * (0.3 + 0.7 * s.next_1d()) }
+        })
+        .collect();
+    let bitmap = lookups_per_second(runs, &exemplar, &lookups);
+    println!("textures   {} lookups on 1 thread, exemplar {} (trilinear):", lookups.len(), file.display());
+    println!("           bitmap                         {bitmap:7.2} M lookups/s  (1.00x the bitmap's cost)");
+    let blends = [
+        ("linear", Blend::Linear),
+        ("mix-max", Blend::MixMax { priority: PriorityMap::new(image), contrast: 4.0, lambda: 0.05 }),
+    ];
+    for (name, blend) in blends {
+        let synthesis = |deformation: Option<DeformationField>| {
+            let s = Synthesis {
+                tiling: Tiling::Hexagonal,
+                tile_size: 0.25,
+                seed: 1,
+                deformation,
+                blend: blend.clone(),
+                inset: false,
+            };
+            TilingBlending::new(Arc::new(s), exemplar.clone())
+                .map(Texture::TilingBlending)
+                .map_err(|e| Error::param("bench", e))
+        };
+        let classical = lookups_per_second(runs, &synthesis(None)?, &lookups);
+        let deformed = lookups_per_second(runs, &synthesis(Some(deformation.clone()))?, &lookups);
+        println!(
+            "           classical T&B, {name:<8}        {classical:7.2} M lookups/s  ({:.2}x the bitmap's cost)",
+            bitmap / classical
+        );
+        println!(
+            "           deformed T&B (F map), {name:<8} {deformed:7.2} M lookups/s  ({:.2}x the bitmap's cost, {:.2}x classical; targets 4x, 1.3x)",
+            bitmap / deformed,
+            classical / deformed
+        );
+    }
     Ok(())
 }

@@ -131,6 +131,9 @@ enum Command {
         /// Folder of the shipped scenes.
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
+        /// Which figures to measure, comma separated (default: all).
+        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures"])]
+        only: Vec<bench::Suite>,
     },
 }
 
@@ -196,11 +199,11 @@ pub fn run() -> Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Command::Bench { runs, threads, scenes } => {
+        Command::Bench { runs, threads, scenes, only } => {
             if runs == 0 {
                 return Err(Error::param("--runs", "must be at least 1"));
             }
-            bench::run(&scenes, runs, threads)?;
+            bench::run(&scenes, runs, threads, &only)?;
             Ok(ExitCode::SUCCESS)
         }
     }

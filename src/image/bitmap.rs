@@ -33,7 +33,7 @@ impl Bitmap {
     }
 
     /// The pixel at column `x`, row `y` as RGBA: grey is replicated, missing alpha is 1.
-    #[inline]
+    #[inline(always)]
     pub fn pixel(&self, x: usize, y: usize) -> Vec4 {
         let i = (y * self.width + x) * self.channels;
         let d = &self.data[i..i + self.channels];

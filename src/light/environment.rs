@@ -96,7 +96,7 @@ impl EnvironmentMap {
         let (w, h) = (self.image.width, self.image.height);
         let x = uv.x * w as f32 - 0.5;
         let y = (uv.y * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (crate::math::floor(x), crate::math::floor(y));
         let (fx, fy) = (x - x0, y - y0);
         let col = |c: f32| (c as i64).rem_euclid(w as i64) as usize;
         let (c0, c1) = (col(x0), col(x0 + 1.0));

@@ -18,7 +18,10 @@
 //!
 //! Not exportable, and reported as an error: the `pbr` material (no Mitsuba plugin has its
 //! Schlick-Fresnel metal blend). Filtered textures (`trilinear`, `ewa`) are exported bilinear,
-//! with a warning: Mitsuba 3.9 has no MIP-mapping.
+//! with a warning: Mitsuba 3.9 has no MIP-mapping. Procedural textures (tiling and blending)
+//! are baked over the UV square at the export's resolution, with a warning; a shading frame
+//! turned by a deformation field has no Mitsuba equivalent and is exported unturned, with a
+//! warning.
 
 use super::Scene;
 use crate::camera::FovAxis;
@@ -208,6 +211,12 @@ impl Exporter<'_> {
 
     /// The `<bsdf>` element of material `index`, with its id.
     fn material(&mut self, index: usize, m: &Material) -> Result<String> {
+        if m.texture_frame.is_some() {
+            self.out.warnings.push(format!(
+                "material {index}: its shading frame follows a deformation field; Mitsuba's follows dp/du, so \
+                 anisotropic roughness and normal maps are exported unturned"
+            ));
+        }
         let inner = match &m.kind {
             MaterialKind::Diffuse { reflectance } => {
                 format!("<bsdf type=\"diffuse\">{}</bsdf>", self.color(reflectance, "reflectance")?)

@@ -3,6 +3,7 @@
 //! Texture coordinates wrap (repeat).
 
 use crate::image::Bitmap;
+use crate::math::{floor, floor2};
 use glam::{Vec2, Vec4};
 
 /// How an image texture is filtered over the hit's footprint.
@@ -121,7 +122,7 @@ impl MipMap {
     }
 
     /// Texel (x, y) of `level`, wrapping.
-    #[inline]
+    #[inline(always)]
     fn texel(&self, level: usize, x: i64, y: i64) -> Vec4 {
         let l = &self.levels[level];
         l.pixel(wrap(x, l.width), wrap(y, l.height))
@@ -134,7 +135,7 @@ impl MipMap {
         let l = &self.levels[level];
         let x = st.x * l.width as f32 - 0.5;
         let y = st.y * l.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
         let top = self.texel(level, x0, y0) * (1.0 - fx) + self.texel(level, x0 + 1, y0) * fx;
@@ -146,7 +147,7 @@ impl MipMap {
     /// [0, 1] image units per pixel).
     pub fn lookup(&self, filter: Filter, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
         // Wrap first so that f32 precision does not degrade far from the origin.
-        let st = st - st.floor();
+        let st = st - floor2(st);
         match filter {
             Filter::None => self.bilinear(0, st),
             Filter::Trilinear => self.at_level(self.trilinear_lod(dst0, dst1), |level| self.bilinear(level, st)),
@@ -181,7 +182,7 @@ impl MipMap {
 
     /// Blend `f` of the two levels around the continuous level `lod`.
     fn at_level(&self, lod: f32, f: impl Fn(usize) -> Vec4) -> Vec4 {
-        let i = lod.floor() as usize;
+        let i = lod as usize;
         let t = lod - i as f32;
         if t == 0.0 || i + 1 >= self.levels.len() { f(i) } else { f(i) * (1.0 - t) + f(i + 1) * t }
     }

@@ -55,7 +55,7 @@ impl Deformation {
                 Mat2::from_cols(Vec2::X, Vec2::new(shear + gradient.dot(uv), 1.0))
             }
             Deformation::Map(map) => {
-                let uv = uv - uv.floor();
+                let uv = uv - crate::math::floor2(uv);
                 let f = map.bilinear(0, Vec2::new(uv.x, 1.0 - uv.y));
                 Mat2::from_cols(Vec2::new(f.x, f.z), Vec2::new(f.y, f.w))
             }

@@ -61,45 +61,44 @@ pub enum Blend {
     },
 }
 
-/// A scalar priority map (the mean of its RGB) with the MIP pyramid of its square, so that a
-/// footprint gives both the priority's mean and its variance.
+/// A scalar priority map (the mean of its RGB) stored with its square in one two-channel MIP
+/// pyramid, so that one filtered lookup gives both the priority's mean and its variance over a
+/// footprint.
 #[derive(Clone, Debug)]
 pub struct PriorityMap {
+    /// Channels: s, s^2 (read back as RGB = s, A = s^2).
     map: ImageTexture,
-    squared: ImageTexture,
 }
 
 impl PriorityMap {
     /// The priority map of an image (its RGB mean).
     pub fn new(image: &ImageTexture) -> Self {
         let base = image.mipmap.level(0);
-        let mut mean = crate::image::Bitmap::new(base.width, base.height, 1);
-        let mut squared = mean.clone();
+        let mut moments = crate::image::Bitmap::new(base.width, base.height, 2);
         for y in 0..base.height {
             for x in 0..base.width {
                 let s = super::Channel::Mean.select(base.pixel(x, y));
-                mean.values_mut(x, y)[0] = s;
-                squared.values_mut(x, y)[0] = s * s;
+                moments.values_mut(x, y).copy_from_slice(&[s, s * s]);
             }
         }
-        let with = |b| ImageTexture {
-            mipmap: Arc::new(super::MipMap::new(b)),
+        let map = ImageTexture {
+            mipmap: Arc::new(super::MipMap::new(moments)),
             filter: image.filter,
             scale: image.scale,
             offset: image.offset,
         };
-        PriorityMap { map: with(mean), squared: with(squared) }
+        PriorityMap { map }
     }
 
     /// Mean and variance of the priority over the lookup's footprint.
     #[inline]
     fn mean_and_variance(&self, ctx: &TexCtx) -> (f32, f32) {
-        let s = self.map.eval(ctx).x;
-        (s, (self.squared.eval(ctx).x - s * s).max(0.0))
+        let v = self.map.eval(ctx);
+        (v.x, (v.w - v.x * v.x).max(0.0))
     }
 
     fn memory_bytes(&self) -> usize {
-        self.map.mipmap.memory_bytes() + self.squared.mipmap.memory_bytes()
+        self.map.mipmap.memory_bytes()
     }
 }
 
@@ -257,7 +256,7 @@ impl Synthesis {
 #[inline]
 fn win_probability(difference: f32, variance: f32) -> f32 {
     if variance > 0.0 {
-        crate::math::normal_cdf((difference / variance.sqrt()) as f64) as f32
+        crate::math::normal_cdf_f32(difference / variance.sqrt())
     } else if difference > 0.0 {
         1.0
     } else if difference < 0.0 {

@@ -2,6 +2,7 @@
 //! cover a point, their centres c_i, their weights w_i (a partition of unity), and their
 //! pseudo-random shifts h_i.
 
+use crate::math::{floor, floor2};
 use glam::{IVec2, Vec2};
 
 /// Most tiles that cover one point (the square grid's four).
@@ -86,7 +87,7 @@ fn hexagonal(uv: Vec2, size: f32) -> [Tile; MAX_TILES] {
     // Lattice ("skewed") coordinates: uv / size = x a1 + y a2.
     let y = uv.y / (size * ROW_HEIGHT);
     let x = uv.x / size - 0.5 * y;
-    let base = Vec2::new(x.floor(), y.floor());
+    let base = Vec2::new(floor(x), floor(y));
     let (fx, fy) = (x - base.x, y - base.y);
     let base = base.as_ivec2();
     let tile = |offset: IVec2, weight: f32| {
@@ -106,7 +107,7 @@ fn hexagonal(uv: Vec2, size: f32) -> [Tile; MAX_TILES] {
 
 fn square(uv: Vec2, size: f32) -> [Tile; MAX_TILES] {
     let p = uv / size;
-    let base = p.floor();
+    let base = floor2(p);
     let f = p - base;
     let smooth = |t: f32| t * t * (3.0 - 2.0 * t);
     let (sx, sy) = (smooth(f.x), smooth(f.y));
