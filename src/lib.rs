@@ -36,6 +36,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod color;
+pub mod deform;
 pub mod error;
 pub mod geometry;
 pub mod image;

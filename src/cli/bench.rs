@@ -6,6 +6,9 @@
 //!   rays (cosine-distributed bounces from the primary hits), on one thread and on all.
 //! - A full render of `scenes/brushed_metal.toml` (Mitsuba scene A: 512 x 512, 64 spp, max
 //!   depth 8): samples per second, against Mitsuba 3's figures measured on this kind of machine.
+//! - `tessera deform`'s computation (deformation gradients, polar decompositions, orientation,
+//!   a 256 x 256 smoothing grid, a 1024 x 1024 F map) on a lat-long UV sphere of 262k
+//!   triangles, one thread.
 //! - Texture lookups on one thread, all on the same exemplar (`scenes/textures/bark.jpg`,
 //!   trilinear) and the same 1M lookups (a raster in scanline order, random footprints): the bitmap itself, classical
 //!   tiling and blending, and deformed tiling and blending with a 256 x 256 F map, for the
@@ -69,6 +72,8 @@ pub enum Suite {
     Render,
     /// Texture lookups: bitmap, classical and deformed tiling and blending.
     Textures,
+    /// `tessera deform` on a mesh of 262k triangles.
+    Deform,
 }
 
 /// Run the benchmarks of `suites` and print a table. `scene_dir` holds the shipped scenes.
@@ -87,6 +92,9 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> R
     }
     if suites.contains(&Suite::Textures) {
         textures(scene_dir, runs)?;
+    }
+    if suites.contains(&Suite::Deform) {
+        deform(runs)?;
     }
     Ok(())
 }
@@ -240,5 +248,24 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
             classical / deformed
         );
     }
+    Ok(())
+}
+
+fn deform(runs: usize) -> Result<()> {
+    let mesh = shapes::uv_sphere(512, 256);
+    let orientation = tessera::deform::Orientation::Parallels(glam::Vec3::Y);
+    let mut times = Vec::new();
+    for _ in 0..runs {
+        let start = Instant::now();
+        let maps = tessera::deform::deformation_maps(&mesh, orientation, 256, 1024)
+            .map_err(|msg| Error::param("bench deform", msg))?;
+        std::hint::black_box(maps.f_map.data.len());
+        times.push(start.elapsed().as_secs_f64());
+    }
+    let seconds = median(times);
+    println!(
+        "deform     UV sphere of {} triangles, grid 256, F map 1024x1024: {seconds:.3} s on 1 thread (target < 1 s)",
+        mesh.indices.len()
+    );
     Ok(())
 }

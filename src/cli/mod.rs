@@ -119,6 +119,25 @@ enum Command {
         #[arg(long, default_value = "texel")]
         footprint: FootprintArg,
     },
+    /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and write it as an F
+    /// map (f_map.exr: F00, F01, F10, F11) with pictures of |det F| and of the orientation.
+    Deform {
+        /// The mesh (OBJ with texture coordinates).
+        mesh: PathBuf,
+        /// Vertices per side of the smoothing grid over the UV square (Eq. 7).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=8192))]
+        grid: u32,
+        /// Texels per side of the F map.
+        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+        res: u32,
+        /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected
+        /// on the surface) or `parallels:X,Y,Z` (circles around an axis through the origin).
+        #[arg(long, default_value = "uv")]
+        orientation: String,
+        /// Output folder (created).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
         /// Runs per figure (the median is printed).
@@ -132,9 +151,66 @@ enum Command {
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
         /// Which figures to measure, comma separated (default: all).
-        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures"])]
+        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures", "deform"])]
         only: Vec<bench::Suite>,
     },
+}
+
+/// Parse `uv`, `fixed:X,Y,Z` or `parallels:X,Y,Z`.
+fn parse_orientation(text: &str) -> Result<tessera::deform::Orientation> {
+    use tessera::deform::Orientation;
+    let bad = || Error::param("--orientation", format!("'{text}': expected uv, fixed:X,Y,Z or parallels:X,Y,Z"));
+    if text == "uv" {
+        return Ok(Orientation::Uv);
+    }
+    let (kind, vector) = text.split_once(':').ok_or_else(bad)?;
+    let v: Vec<f32> =
+        vector.split(',').map(|x| x.trim().parse::<f32>()).collect::<std::result::Result<_, _>>().map_err(|_| bad())?;
+    let [x, y, z] = v[..] else { return Err(bad()) };
+    let d = glam::Vec3::new(x, y, z);
+    if !(d.is_finite() && d.length_squared() > 0.0) {
+        return Err(bad());
+    }
+    match kind {
+        "fixed" => Ok(Orientation::Fixed(d)),
+        "parallels" => Ok(Orientation::Parallels(d.normalize())),
+        _ => Err(bad()),
+    }
+}
+
+/// `tessera deform`.
+fn deform(mesh_path: &Path, grid: usize, res: usize, orientation: &str, output: &Path) -> Result<ExitCode> {
+    let orientation = parse_orientation(orientation)?;
+    let start = Instant::now();
+    let mesh = tessera::geometry::obj::load_obj(mesh_path)?;
+    let loaded = start.elapsed().as_secs_f64();
+    let maps =
+        tessera::deform::deformation_maps(&mesh, orientation, grid, res).map_err(|msg| Error::mesh(mesh_path, msg))?;
+    let computed = start.elapsed().as_secs_f64() - loaded;
+    std::fs::create_dir_all(output).map_err(|e| Error::io(output, e))?;
+    let f = &maps.f_map;
+    let plane = |c: usize| f.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
+    let channels = ["R", "G", "B", "A"].iter().enumerate().map(|(c, name)| (name.to_string(), plane(c))).collect();
+    tessera::image::write_exr(&output.join("f_map.exr"), f.width, f.height, channels)?;
+    let (det, orientation_picture) = tessera::deform::f_map_pictures(f);
+    write_image(&output.join("det_f.png"), &det, &[])?;
+    write_image(&output.join("orientation.png"), &orientation_picture, &[])?;
+    if maps.degenerate > 0 {
+        eprintln!(
+            "warning: {}: {} triangles are degenerate in 3D or in UV; their grid samples take the nearest triangle's values",
+            mesh_path.display(),
+            maps.degenerate
+        );
+    }
+    eprintln!(
+        "{}: {} triangles ({} mirrored in UV), grid {grid}x{grid} ({} samples outside every triangle, filled from the nearest), F map {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; wrote f_map.exr, det_f.png, orientation.png to {}",
+        mesh_path.display(),
+        mesh.indices.len(),
+        maps.mirrored,
+        maps.grid.filled,
+        output.display()
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Footprints of `tessera bake`.
@@ -198,6 +274,9 @@ pub fn run() -> Result<ExitCode> {
                 output.display()
             );
             Ok(ExitCode::SUCCESS)
+        }
+        Command::Deform { mesh, grid, res, orientation, output } => {
+            deform(&mesh, grid as usize, res as usize, &orientation, &output)
         }
         Command::Bench { runs, threads, scenes, only } => {
             if runs == 0 {

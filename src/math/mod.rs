@@ -1,4 +1,9 @@
-//! Small numerical tools: a fast floor, quadrature, the standard normal distribution.
+//! Small numerical tools: a fast floor, quadrature, the standard normal distribution, and the
+//! polar decomposition of 3x3 matrices.
+
+mod polar;
+
+pub use polar::{polar_decomposition, symmetric_eigen};
 
 /// Nodes and weights of the n-point Gauss-Legendre rule on [-1, 1], by Newton iteration on the
 /// Legendre polynomial P_n (Golub-Welsch would do as well; n is small here).

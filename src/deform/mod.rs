@@ -1,0 +1,115 @@
+//! The deformation field of a UV-mapped mesh (paper 000 Sec. 4; DESIGN.md section 5): per
+//! triangle the deformation gradient and its polar decomposition, an orientation angle from a
+//! tangent field, the grid smoothing of Eq. 7, and the F map that a tiling-and-blending texture
+//! reads (`deformation = [{ type = "map", ... }]`).
+
+mod gradient;
+mod grid;
+
+pub use gradient::{TriangleDeformation, deformation_gradient};
+pub use grid::{FieldGrid, FieldSample};
+
+use crate::geometry::TriangleMesh;
+use crate::image::Bitmap;
+use glam::{Vec2, Vec3};
+
+/// The tangent field o that orients the texture (Sec. 4.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Orientation {
+    /// None: F = S (Sec. 4.2), the texture oriented by the UV iso-lines.
+    Uv,
+    /// A fixed direction projected on each triangle's plane.
+    Fixed(Vec3),
+    /// Along the parallels around an axis through the origin: o = axis x p.
+    Parallels(Vec3),
+}
+
+impl Orientation {
+    /// The direction o at the point `p` (not yet projected on the tangent plane); None for
+    /// [`Orientation::Uv`].
+    fn at(self, p: Vec3) -> Option<Vec3> {
+        match self {
+            Orientation::Uv => None,
+            Orientation::Fixed(d) => Some(d),
+            Orientation::Parallels(axis) => Some(axis.cross(p)),
+        }
+    }
+}
+
+/// What `tessera deform` computes from a mesh.
+#[derive(Clone, Debug)]
+pub struct DeformationMaps {
+    /// The smoothing grid (theta and S at its vertices).
+    pub grid: FieldGrid,
+    /// The F map: `res` x `res`, 4 channels (F00, F01, F10, F11), row 0 at the top (v = 1), as
+    /// image textures are laid out, sampled at texel centres from the grid (Eq. 7).
+    pub f_map: Bitmap,
+    /// Triangles skipped because they are degenerate in 3D or in UV.
+    pub degenerate: usize,
+    /// Triangles whose UVs are mirrored (R is a reflection there).
+    pub mirrored: usize,
+}
+
+/// Derive the deformation field of `mesh` (which must have UVs): F = R(theta) S per triangle,
+/// smoothed on a `grid` x `grid` grid, written as a `res` x `res` F map.
+pub fn deformation_maps(
+    mesh: &TriangleMesh,
+    orientation: Orientation,
+    grid: usize,
+    res: usize,
+) -> Result<DeformationMaps, String> {
+    let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
+    if grid == 0 || res == 0 {
+        return Err("the grid and the map need at least one sample per side".into());
+    }
+    let mut degenerate = 0;
+    let mut mirrored = 0;
+    let mut uv_triangles = Vec::with_capacity(mesh.indices.len());
+    let values: Vec<Option<FieldSample>> = mesh
+        .indices
+        .iter()
+        .map(|idx| {
+            let x = idx.map(|i| mesh.positions[i as usize]);
+            let u = idx.map(|i| uvs[i as usize]);
+            uv_triangles.push(u);
+            let Some(d) = TriangleDeformation::new(x, u) else {
+                degenerate += 1;
+                return None;
+            };
+            if d.rotation.determinant() < 0.0 {
+                mirrored += 1;
+            }
+            let centroid = (x[0] + x[1] + x[2]) / 3.0;
+            let theta = orientation.at(centroid).map_or(0.0, |o| d.orientation_angle(o));
+            Some(FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch })
+        })
+        .collect();
+    let grid = FieldGrid::new(grid, &uv_triangles, &values).ok_or("every triangle is degenerate")?;
+    let mut f_map = Bitmap::new(res, res, 4);
+    for (row, line) in f_map.data.chunks_exact_mut(res * 4).enumerate() {
+        let v = ((res - 1 - row) as f32 + 0.5) / res as f32;
+        for (col, px) in line.chunks_exact_mut(4).enumerate() {
+            let f = grid.at(Vec2::new((col as f32 + 0.5) / res as f32, v));
+            px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
+        }
+    }
+    Ok(DeformationMaps { grid, f_map, degenerate, mirrored })
+}
+
+/// Pictures of an F map for people to look at: log2 |det F| as grey (0.5 at 1, black at 1/16,
+/// white at 16) and the texture's orientation (the angle of F^-1 e1) as a colour wheel.
+pub fn f_map_pictures(f_map: &Bitmap) -> (Bitmap, Bitmap) {
+    let mut det = Bitmap::new(f_map.width, f_map.height, 3);
+    let mut orientation = Bitmap::new(f_map.width, f_map.height, 3);
+    for (k, f) in f_map.data.chunks_exact(4).enumerate() {
+        let d = f[0] * f[3] - f[1] * f[2];
+        let grey = (0.5 + d.abs().max(1e-12).log2() / 8.0).clamp(0.0, 1.0);
+        // F^-1 e1 is along (f11, -f10).
+        let angle = (-f[2]).atan2(f[3]);
+        let colour = [angle, angle - 2.094_395_1, angle + 2.094_395_1].map(|a| 0.5 + 0.5 * a.cos());
+        // Stored linear; PNG output applies the sRGB curve.
+        det.data[k * 3..k * 3 + 3].copy_from_slice(&[grey * grey; 3]);
+        orientation.data[k * 3..k * 3 + 3].copy_from_slice(&colour.map(|c| c * c));
+    }
+    (det, orientation)
+}

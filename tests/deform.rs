@@ -1,0 +1,138 @@
+//! The deformation field of a UV-mapped mesh (paper 000 Sec. 4) against what it must be: on a
+//! developable surface unrolled isometrically F is a rotation everywhere; a uniformly scaled
+//! chart gives F = s R; degenerate triangles are reported and filled, never NaN.
+
+mod common;
+
+use glam::{Mat2, Vec2, Vec3};
+use tessera::deform::{Orientation, deformation_maps};
+use tessera::geometry::TriangleMesh;
+
+/// A strip of a cylinder of radius 0.5 about y (angles 0 to 1.6, height 0 to 0.8), unrolled
+/// isometrically: u is the arc length along the polyline of chords (so that every flat triangle
+/// keeps its shape exactly), times `scale`, and v the height times `scale`.
+fn cylinder_strip(scale: f32) -> TriangleMesh {
+    let (segments, rows) = (24, 8);
+    let mut mesh = TriangleMesh::default();
+    let mut uvs = Vec::new();
+    let mut arc = 0.0;
+    let point = |k: usize| {
+        let a = 1.6 * k as f32 / segments as f32;
+        Vec3::new(0.5 * a.cos(), 0.0, 0.5 * a.sin())
+    };
+    for k in 0..=segments {
+        if k > 0 {
+            arc += point(k).distance(point(k - 1));
+        }
+        for r in 0..=rows {
+            let h = 0.8 * r as f32 / rows as f32;
+            mesh.positions.push(point(k) + Vec3::Y * h);
+            uvs.push((Vec2::new(arc, h) + Vec2::splat(0.05)) * scale);
+        }
+    }
+    for k in 0..segments {
+        for r in 0..rows {
+            let i = (k * (rows + 1) + r) as u32;
+            let j = i + rows as u32 + 1;
+            mesh.indices.push([i, j, i + 1]);
+            mesh.indices.push([i + 1, j, j + 1]);
+        }
+    }
+    mesh.uvs = Some(uvs);
+    mesh
+}
+
+fn each_f(map: &tessera::image::Bitmap) -> impl Iterator<Item = Mat2> + '_ {
+    map.data.chunks_exact(4).map(|f| Mat2::from_cols(Vec2::new(f[0], f[2]), Vec2::new(f[1], f[3])))
+}
+
+#[test]
+fn an_isometrically_unrolled_developable_surface_gives_rotations() {
+    for orientation in [Orientation::Uv, Orientation::Fixed(Vec3::Y), Orientation::Parallels(Vec3::Y)] {
+        for scale in [1.0f32, 0.5] {
+            let maps = deformation_maps(&cylinder_strip(scale), orientation, 32, 64).unwrap();
+            assert_eq!(maps.degenerate, 0);
+            // F = R(theta) S with S = I / scale: F^T F = I / scale^2, det F = 1 / scale^2.
+            for f in each_f(&maps.f_map) {
+                let ftf = f.transpose() * f * (scale * scale);
+                assert!(
+                    (ftf - Mat2::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 2e-3),
+                    "{orientation:?}: F^T F = {ftf}"
+                );
+                assert!((f.determinant() * scale * scale - 1.0).abs() < 2e-3);
+            }
+        }
+    }
+    // With the UV orientation F is S alone: the identity here.
+    let maps = deformation_maps(&cylinder_strip(1.0), Orientation::Uv, 32, 64).unwrap();
+    assert!(each_f(&maps.f_map).all(|f| (f - Mat2::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 2e-3)));
+}
+
+#[test]
+fn fixed_orientation_lays_the_texture_along_the_direction() {
+    // On the strip, the texture's x axis on the surface (J F^-1 e1, J = [dp/du dp/dv]) must run
+    // along y, the cylinder's axis, which in this UV map is +v: so F^-1 e1 is along +v.
+    let maps = deformation_maps(&cylinder_strip(1.0), Orientation::Fixed(Vec3::Y), 32, 64).unwrap();
+    for f in each_f(&maps.f_map) {
+        let along = (f.inverse() * Vec2::X).normalize();
+        assert!(along.distance(Vec2::Y) < 1e-3, "{along}");
+    }
+}
+
+#[test]
+fn degenerate_triangles_are_counted_and_filled() {
+    let mut mesh = cylinder_strip(1.0);
+    let uvs = mesh.uvs.as_mut().unwrap();
+    // Collapse the UVs of the first triangle and the 3D positions of another's.
+    let [a, b, c] = mesh.indices[0];
+    uvs[b as usize] = uvs[a as usize];
+    uvs[c as usize] = uvs[a as usize];
+    let [d, e, _] = mesh.indices[100];
+    mesh.positions[e as usize] = mesh.positions[d as usize];
+    let maps = deformation_maps(&mesh, Orientation::Uv, 32, 64).unwrap();
+    assert!(maps.degenerate >= 2, "{}", maps.degenerate);
+    assert!(maps.f_map.data.iter().all(|v| v.is_finite()));
+    // A mesh without UVs, or with every triangle degenerate, is an error, not a panic.
+    let mut no_uv = cylinder_strip(1.0);
+    no_uv.uvs = None;
+    assert!(deformation_maps(&no_uv, Orientation::Uv, 8, 8).is_err());
+    let mut flat = cylinder_strip(1.0);
+    flat.uvs.as_mut().unwrap().iter_mut().for_each(|u| *u = Vec2::splat(0.5));
+    assert!(deformation_maps(&flat, Orientation::Uv, 8, 8).is_err());
+}
+
+#[test]
+fn cli_writes_the_f_map_and_pictures() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = cylinder_strip(1.0);
+    let uvs = mesh.uvs.as_ref().unwrap();
+    let mut obj = String::new();
+    for (p, t) in mesh.positions.iter().zip(uvs) {
+        obj += &format!("v {} {} {}\nvt {} {}\n", p.x, p.y, p.z, t.x, t.y);
+    }
+    for [a, b, c] in &mesh.indices {
+        obj += &format!("f {0}/{0} {1}/{1} {2}/{2}\n", a + 1, b + 1, c + 1);
+    }
+    std::fs::write(dir.path().join("strip.obj"), obj).unwrap();
+    let out = dir.path().join("maps");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("deform")
+        .arg(dir.path().join("strip.obj"))
+        .args(["--grid", "16", "--res", "32", "--orientation", "fixed:0,1,0", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let f = tessera::image::read_bitmap(&out.join("f_map.exr"), tessera::image::ColorSpace::Linear).unwrap();
+    assert_eq!((f.width, f.height, f.channels), (32, 32, 4));
+    assert!(out.join("det_f.png").exists() && out.join("orientation.png").exists());
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("deform")
+        .arg(dir.path().join("strip.obj"))
+        .args(["--orientation", "sideways", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--orientation"));
+}
