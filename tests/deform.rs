@@ -136,3 +136,19 @@ fn cli_writes_the_f_map_and_pictures() {
     assert_eq!(bad.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--orientation"));
 }
+
+#[test]
+fn the_field_compensates_a_lat_long_sphere_distortion() {
+    // The composite map surface -> exemplar (F J^+) of classical T&B on a lat-long sphere is
+    // anisotropic and its scale varies with latitude; the deformation field (as the renderer
+    // reads the F map) makes it nearly conformal and uniform.
+    let mesh = tessera::geometry::shapes::uv_sphere(64, 32);
+    let maps = deformation_maps(&mesh, Orientation::Uv, 64, 256).unwrap();
+    let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map));
+    let classical = tessera::deform::distortion(&mesh, |_| Mat2::IDENTITY).unwrap();
+    let deformed = tessera::deform::distortion(&mesh, |uv| f.at(uv)).unwrap();
+    eprintln!("lat-long sphere: classical {classical:?}, deformed {deformed:?}");
+    assert!(classical.mean_anisotropy > 1.3 && classical.std_log_area > 0.3, "{classical:?}");
+    assert!(deformed.mean_anisotropy < 1.05, "{deformed:?}");
+    assert!(deformed.std_log_area < 0.1 * classical.std_log_area, "{deformed:?}");
+}

@@ -195,6 +195,18 @@ fn deform(mesh_path: &Path, grid: usize, res: usize, orientation: &str, output: 
     let (det, orientation_picture) = tessera::deform::f_map_pictures(f);
     write_image(&output.join("det_f.png"), &det, &[])?;
     write_image(&output.join("orientation.png"), &orientation_picture, &[])?;
+    // Distortion of the texture on the surface, as the renderer reads the written F map.
+    let f_texture =
+        tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map.clone()));
+    let classical = tessera::deform::distortion(&mesh, |_| glam::Mat2::IDENTITY);
+    let deformed = tessera::deform::distortion(&mesh, |uv| f_texture.at(uv));
+    if let (Some(c), Some(d)) = (classical, deformed) {
+        eprintln!(
+            "distortion over {} triangles (area-weighted): mean sigma_max/sigma_min classical {:.3}, deformed {:.3}; \
+             std of ln(sigma_1 sigma_2) classical {:.3}, deformed {:.3}",
+            c.triangles, c.mean_anisotropy, d.mean_anisotropy, c.std_log_area, d.std_log_area
+        );
+    }
     if maps.degenerate > 0 {
         eprintln!(
             "warning: {}: {} triangles are degenerate in 3D or in UV; their grid samples take the nearest triangle's values",

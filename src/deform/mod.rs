@@ -3,9 +3,11 @@
 //! tangent field, the grid smoothing of Eq. 7, and the F map that a tiling-and-blending texture
 //! reads (`deformation = [{ type = "map", ... }]`).
 
+mod distortion;
 mod gradient;
 mod grid;
 
+pub use distortion::{Distortion, distortion};
 pub use gradient::{TriangleDeformation, deformation_gradient};
 pub use grid::{FieldGrid, FieldSample};
 
