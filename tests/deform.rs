@@ -48,9 +48,14 @@ fn each_f(map: &tessera::image::Bitmap) -> impl Iterator<Item = Mat2> + '_ {
 
 #[test]
 fn an_isometrically_unrolled_developable_surface_gives_rotations() {
-    for orientation in [Orientation::Uv, Orientation::Fixed(Vec3::Y), Orientation::Parallels(Vec3::Y)] {
+    for orientation in [
+        Orientation::Uv,
+        Orientation::Fixed(Vec3::Y),
+        Orientation::Parallels(Vec3::Y),
+        Orientation::Geodesic(vec![Vec3::ZERO]),
+    ] {
         for scale in [1.0f32, 0.5] {
-            let maps = deformation_maps(&cylinder_strip(scale), orientation, 32, 64).unwrap();
+            let maps = deformation_maps(&cylinder_strip(scale), &orientation, 32, 64).unwrap();
             assert_eq!(maps.degenerate, 0);
             // F = R(theta) S with S = I / scale: F^T F = I / scale^2, det F = 1 / scale^2.
             for f in each_f(&maps.f_map) {
@@ -64,7 +69,7 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
         }
     }
     // With the UV orientation F is S alone: the identity here.
-    let maps = deformation_maps(&cylinder_strip(1.0), Orientation::Uv, 32, 64).unwrap();
+    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Uv, 32, 64).unwrap();
     assert!(each_f(&maps.f_map).all(|f| (f - Mat2::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 2e-3)));
 }
 
@@ -72,7 +77,7 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
 fn fixed_orientation_lays_the_texture_along_the_direction() {
     // On the strip, the texture's x axis on the surface (J F^-1 e1, J = [dp/du dp/dv]) must run
     // along y, the cylinder's axis, which in this UV map is +v: so F^-1 e1 is along +v.
-    let maps = deformation_maps(&cylinder_strip(1.0), Orientation::Fixed(Vec3::Y), 32, 64).unwrap();
+    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Fixed(Vec3::Y), 32, 64).unwrap();
     for f in each_f(&maps.f_map) {
         let along = (f.inverse() * Vec2::X).normalize();
         assert!(along.distance(Vec2::Y) < 1e-3, "{along}");
@@ -89,16 +94,16 @@ fn degenerate_triangles_are_counted_and_filled() {
     uvs[c as usize] = uvs[a as usize];
     let [d, e, _] = mesh.indices[100];
     mesh.positions[e as usize] = mesh.positions[d as usize];
-    let maps = deformation_maps(&mesh, Orientation::Uv, 32, 64).unwrap();
+    let maps = deformation_maps(&mesh, &Orientation::Uv, 32, 64).unwrap();
     assert!(maps.degenerate >= 2, "{}", maps.degenerate);
     assert!(maps.f_map.data.iter().all(|v| v.is_finite()));
     // A mesh without UVs, or with every triangle degenerate, is an error, not a panic.
     let mut no_uv = cylinder_strip(1.0);
     no_uv.uvs = None;
-    assert!(deformation_maps(&no_uv, Orientation::Uv, 8, 8).is_err());
+    assert!(deformation_maps(&no_uv, &Orientation::Uv, 8, 8).is_err());
     let mut flat = cylinder_strip(1.0);
     flat.uvs.as_mut().unwrap().iter_mut().for_each(|u| *u = Vec2::splat(0.5));
-    assert!(deformation_maps(&flat, Orientation::Uv, 8, 8).is_err());
+    assert!(deformation_maps(&flat, &Orientation::Uv, 8, 8).is_err());
 }
 
 #[test]
@@ -143,7 +148,7 @@ fn the_field_compensates_a_lat_long_sphere_distortion() {
     // anisotropic and its scale varies with latitude; the deformation field (as the renderer
     // reads the F map) makes it nearly conformal and uniform.
     let mesh = tessera::geometry::shapes::uv_sphere(64, 32);
-    let maps = deformation_maps(&mesh, Orientation::Uv, 64, 256).unwrap();
+    let maps = deformation_maps(&mesh, &Orientation::Uv, 64, 256).unwrap();
     let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map));
     let classical = tessera::deform::distortion(&mesh, |_| Mat2::IDENTITY).unwrap();
     let deformed = tessera::deform::distortion(&mesh, |uv| f.at(uv)).unwrap();
@@ -151,4 +156,19 @@ fn the_field_compensates_a_lat_long_sphere_distortion() {
     assert!(classical.mean_anisotropy > 1.3 && classical.std_log_area > 0.3, "{classical:?}");
     assert!(deformed.mean_anisotropy < 1.05, "{deformed:?}");
     assert!(deformed.std_log_area < 0.1 * classical.std_log_area, "{deformed:?}");
+}
+
+#[test]
+fn geodesic_orientation_runs_away_from_the_source() {
+    // Source at the strip's start (arc length 0, mid-height): far from it the distance grows
+    // along the arc, so the texture's x axis must point along +u where the strip is long.
+    let strip = cylinder_strip(1.0);
+    let source = Vec3::new(0.5, 0.4, 0.0);
+    let maps = deformation_maps(&strip, &Orientation::Geodesic(vec![source]), 32, 64).unwrap();
+    let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map));
+    // At the middle height, beyond the first third of the strip: away from the source is +u.
+    for u in [0.5f32, 0.7, 0.85] {
+        let along = (f.at(Vec2::new(u, 0.45)).inverse() * Vec2::X).normalize();
+        assert!(along.dot(Vec2::X) > 0.97, "at u = {u}: texture x along {along}");
+    }
 }

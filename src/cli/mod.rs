@@ -131,7 +131,9 @@ enum Command {
         #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
         res: u32,
         /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected
-        /// on the surface) or `parallels:X,Y,Z` (circles around an axis through the origin).
+        /// on the surface), `parallels:X,Y,Z` (circles around an axis through the origin) or
+        /// `geodesic:X,Y,Z[;X,Y,Z...]` (away from the vertices nearest to these points, along the
+        /// gradient of the distance over the surface).
         #[arg(long, default_value = "uv")]
         orientation: String,
         /// Output folder (created).
@@ -156,24 +158,37 @@ enum Command {
     },
 }
 
-/// Parse `uv`, `fixed:X,Y,Z` or `parallels:X,Y,Z`.
+/// Parse `uv`, `fixed:X,Y,Z`, `parallels:X,Y,Z` or `geodesic:X,Y,Z[;X,Y,Z...]`.
 fn parse_orientation(text: &str) -> Result<tessera::deform::Orientation> {
     use tessera::deform::Orientation;
-    let bad = || Error::param("--orientation", format!("'{text}': expected uv, fixed:X,Y,Z or parallels:X,Y,Z"));
+    let bad = || {
+        Error::param(
+            "--orientation",
+            format!("'{text}': expected uv, fixed:X,Y,Z, parallels:X,Y,Z or geodesic:X,Y,Z[;X,Y,Z...]"),
+        )
+    };
     if text == "uv" {
         return Ok(Orientation::Uv);
     }
-    let (kind, vector) = text.split_once(':').ok_or_else(bad)?;
-    let v: Vec<f32> =
-        vector.split(',').map(|x| x.trim().parse::<f32>()).collect::<std::result::Result<_, _>>().map_err(|_| bad())?;
-    let [x, y, z] = v[..] else { return Err(bad()) };
-    let d = glam::Vec3::new(x, y, z);
-    if !(d.is_finite() && d.length_squared() > 0.0) {
-        return Err(bad());
-    }
+    let (kind, vectors) = text.split_once(':').ok_or_else(bad)?;
+    let points = vectors
+        .split(';')
+        .map(|v| {
+            let c: Vec<f32> =
+                v.split(',').map(|x| x.trim().parse::<f32>()).collect::<std::result::Result<_, _>>().ok()?;
+            let [x, y, z] = c[..] else { return None };
+            Some(glam::Vec3::new(x, y, z)).filter(|p| p.is_finite())
+        })
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(bad)?;
+    let single = || match points[..] {
+        [d] if d.length_squared() > 0.0 => Ok(d),
+        _ => Err(bad()),
+    };
     match kind {
-        "fixed" => Ok(Orientation::Fixed(d)),
-        "parallels" => Ok(Orientation::Parallels(d.normalize())),
+        "fixed" => Ok(Orientation::Fixed(single()?)),
+        "parallels" => Ok(Orientation::Parallels(single()?.normalize())),
+        "geodesic" => Ok(Orientation::Geodesic(points)),
         _ => Err(bad()),
     }
 }
@@ -185,7 +200,7 @@ fn deform(mesh_path: &Path, grid: usize, res: usize, orientation: &str, output: 
     let mesh = tessera::geometry::obj::load_obj(mesh_path)?;
     let loaded = start.elapsed().as_secs_f64();
     let maps =
-        tessera::deform::deformation_maps(&mesh, orientation, grid, res).map_err(|msg| Error::mesh(mesh_path, msg))?;
+        tessera::deform::deformation_maps(&mesh, &orientation, grid, res).map_err(|msg| Error::mesh(mesh_path, msg))?;
     let computed = start.elapsed().as_secs_f64() - loaded;
     std::fs::create_dir_all(output).map_err(|e| Error::io(output, e))?;
     let f = &maps.f_map;

@@ -4,6 +4,7 @@
 //! reads (`deformation = [{ type = "map", ... }]`).
 
 mod distortion;
+mod geodesic;
 mod gradient;
 mod grid;
 
@@ -16,7 +17,7 @@ use crate::image::Bitmap;
 use glam::{Vec2, Vec3};
 
 /// The tangent field o that orients the texture (Sec. 4.3).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Orientation {
     /// None: F = S (Sec. 4.2), the texture oriented by the UV iso-lines.
     Uv,
@@ -24,16 +25,34 @@ pub enum Orientation {
     Fixed(Vec3),
     /// Along the parallels around an axis through the origin: o = axis x p.
     Parallels(Vec3),
+    /// Along the gradient of the distance over the surface from the vertices nearest to these
+    /// points (Sec. 6.3): the texture runs away from them.
+    Geodesic(Vec<Vec3>),
 }
 
 impl Orientation {
-    /// The direction o at the point `p` (not yet projected on the tangent plane); None for
-    /// [`Orientation::Uv`].
-    fn at(self, p: Vec3) -> Option<Vec3> {
+    /// The direction o on each triangle of `mesh` (not yet projected on its plane); None where
+    /// there is none ([`Orientation::Uv`], a vanishing gradient).
+    fn per_triangle(&self, mesh: &TriangleMesh) -> Vec<Option<Vec3>> {
+        let corners = |idx: &[u32; 3]| idx.map(|i| mesh.positions[i as usize]);
         match self {
-            Orientation::Uv => None,
-            Orientation::Fixed(d) => Some(d),
-            Orientation::Parallels(axis) => Some(axis.cross(p)),
+            Orientation::Uv => vec![None; mesh.indices.len()],
+            Orientation::Fixed(d) => vec![Some(*d); mesh.indices.len()],
+            Orientation::Parallels(axis) => mesh
+                .indices
+                .iter()
+                .map(|idx| {
+                    let x = corners(idx);
+                    Some(axis.cross((x[0] + x[1] + x[2]) / 3.0))
+                })
+                .collect(),
+            Orientation::Geodesic(sources) => {
+                let d = geodesic::surface_distances(mesh, sources);
+                mesh.indices
+                    .iter()
+                    .map(|idx| geodesic::triangle_gradient(corners(idx), idx.map(|i| d[i as usize])))
+                    .collect()
+            }
         }
     }
 }
@@ -56,7 +75,7 @@ pub struct DeformationMaps {
 /// smoothed on a `grid` x `grid` grid, written as a `res` x `res` F map.
 pub fn deformation_maps(
     mesh: &TriangleMesh,
-    orientation: Orientation,
+    orientation: &Orientation,
     grid: usize,
     res: usize,
 ) -> Result<DeformationMaps, String> {
@@ -67,10 +86,12 @@ pub fn deformation_maps(
     let mut degenerate = 0;
     let mut mirrored = 0;
     let mut uv_triangles = Vec::with_capacity(mesh.indices.len());
+    let directions = orientation.per_triangle(mesh);
     let values: Vec<Option<FieldSample>> = mesh
         .indices
         .iter()
-        .map(|idx| {
+        .zip(&directions)
+        .map(|(idx, direction)| {
             let x = idx.map(|i| mesh.positions[i as usize]);
             let u = idx.map(|i| uvs[i as usize]);
             uv_triangles.push(u);
@@ -81,8 +102,7 @@ pub fn deformation_maps(
             if d.rotation.determinant() < 0.0 {
                 mirrored += 1;
             }
-            let centroid = (x[0] + x[1] + x[2]) / 3.0;
-            let theta = orientation.at(centroid).map_or(0.0, |o| d.orientation_angle(o));
+            let theta = direction.map_or(0.0, |o| d.orientation_angle(o));
             Some(FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch })
         })
         .collect();
