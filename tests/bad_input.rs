@@ -246,7 +246,15 @@ fn bad_tiling_and_blending_textures_are_named() {
         .unwrap();
         std::fs::read(&p).unwrap()
     };
-    let files: &[(&str, &[u8])] = &[("e.png", &png), ("f.exr", &three_channel_exr)];
+    let nan_exr = {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("n.exr");
+        let plane = vec![1.0f32, f32::NAN, 1.0, 1.0];
+        let channels = ["R", "G", "B", "A"].iter().map(|c| (c.to_string(), plane.clone())).collect();
+        tessera::image::write_exr(&p, 2, 2, channels).unwrap();
+        std::fs::read(&p).unwrap()
+    };
+    let files: &[(&str, &[u8])] = &[("e.png", &png), ("f.exr", &three_channel_exr), ("n.exr", &nan_exr)];
     let with = |tb: &str, extra: &str| {
         format!(
             "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n{extra}\
@@ -278,6 +286,11 @@ fn bad_tiling_and_blending_textures_are_named() {
         &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"f.exr\" }]", ""),
         files,
         &["f.exr", "4 channels", "textures.tb.deformation[0]"],
+    );
+    error_of(
+        &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"n.exr\" }]", ""),
+        files,
+        &["n.exr", "NaN", "textures.tb.deformation[0]"],
     );
     error_of(
         &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"none.exr\" }]", ""),

@@ -172,3 +172,37 @@ fn geodesic_orientation_runs_away_from_the_source() {
         assert!(along.dot(Vec2::X) > 0.97, "at u = {u}: texture x along {along}");
     }
 }
+
+#[test]
+fn a_scene_reads_the_written_f_map_as_the_grid_gives_it() {
+    // tessera deform's F map, referenced by a tiling_blending texture, orients the texture as
+    // Eq. 7 says at the map's texel centres (where the renderer's bilinear lookup is exact).
+    // Its entries are signed (here F = -I where theta = pi): nothing may clamp them on load.
+    let strip = cylinder_strip(1.0);
+    let maps = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), 16, 32).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let f = &maps.f_map;
+    let plane = |c: usize| f.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
+    let channels = ["R", "G", "B", "A"].iter().enumerate().map(|(c, n)| (n.to_string(), plane(c))).collect();
+    tessera::image::write_exr(&dir.path().join("f_map.exr"), 32, 32, channels).unwrap();
+    let mut png = Vec::new();
+    image::GrayImage::from_pixel(4, 4, image::Luma([128]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    std::fs::write(dir.path().join("e.png"), png).unwrap();
+    std::fs::write(
+        dir.path().join("scene.toml"),
+        "[camera]\nfov = 30\neye = [0, 0, 5]\ntarget = [0, 0, 0]\n\
+         [textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
+         [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"f_map.exr\" }]\n",
+    )
+    .unwrap();
+    let texture = tessera::scene::load_texture(&dir.path().join("scene.toml"), "tb", true).unwrap();
+    for (i, j) in [(3, 4), (10, 20), (25, 7), (31, 31)] {
+        let uv = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / 32.0;
+        let expected = (maps.grid.at(uv).inverse() * Vec2::X).normalize();
+        let (direction, reversed) = texture.tangent_direction(uv).expect("a deformed texture has a direction");
+        assert!(!reversed);
+        assert!(direction.normalize().distance(expected) < 1e-4, "at {uv}: {direction} vs {expected}");
+    }
+}

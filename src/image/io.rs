@@ -27,17 +27,24 @@ impl OutputFormat {
     }
 }
 
-/// Read an image file as floats. Integer colour channels are divided by their maximum and,
-/// with [`ColorSpace::Srgb`], sRGB-decoded (alpha never is); float files (EXR, HDR) are linear
-/// whatever `space` says. Negative values (lossy EXR compression) and non-finite ones become 0.
+/// Read an image of colours or radiance as floats: [`read_bitmap_raw`], then negative values
+/// (lossy EXR compression) and non-finite ones become 0.
 pub fn read_bitmap(path: &Path, space: ColorSpace) -> Result<Bitmap> {
-    let is_exr = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    let mut bitmap = if is_exr { read_exr(path)? } else { read_with_image_crate(path, space)? };
+    let mut bitmap = read_bitmap_raw(path, space)?;
     for v in &mut bitmap.data {
         if !(v.is_finite() && *v >= 0.0) {
             *v = 0.0;
         }
     }
+    Ok(bitmap)
+}
+
+/// Read an image file as floats, as stored (signed data such as F maps). Integer colour
+/// channels are divided by their maximum and, with [`ColorSpace::Srgb`], sRGB-decoded (alpha
+/// never is); float files (EXR, HDR) are linear whatever `space` says.
+pub fn read_bitmap_raw(path: &Path, space: ColorSpace) -> Result<Bitmap> {
+    let is_exr = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let bitmap = if is_exr { read_exr(path)? } else { read_with_image_crate(path, space)? };
     if bitmap.width == 0 || bitmap.height == 0 {
         return Err(Error::image(path, "the image is empty"));
     }

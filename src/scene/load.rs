@@ -12,7 +12,7 @@ use crate::camera::{FovAxis, PerspectiveCamera};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::geometry::{TriangleMesh, obj, shapes};
-use crate::image::{ColorSpace, read_bitmap};
+use crate::image::{ColorSpace, read_bitmap, read_bitmap_raw};
 use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
@@ -458,7 +458,8 @@ impl<'a> Loader<'a> {
             }
             DeformationDesc::Map { filename } => {
                 let file = self.resolve_path(filename);
-                let bitmap = read_bitmap(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, item))?;
+                // Signed data: F maps have negative entries.
+                let bitmap = read_bitmap_raw(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, item))?;
                 if bitmap.channels != 4 {
                     return Err(Error::image(
                         &file,
