@@ -655,32 +655,17 @@ impl<'a> Loader<'a> {
                 two_sided,
                 normal_map,
             } => {
-                let unit = |x: f32| (0.0..=1.0).contains(&x);
                 let base_color = self.color(base_color.as_ref(), 1.0, &format!("{item}.base_color"))?;
-                let metallic = self.float(
-                    metallic.as_ref().unwrap_or(&FloatValue::Value(1.0)),
-                    &format!("{item}.metallic"),
-                    unit,
-                    "in [0, 1]",
-                )?;
-                let roughness = self.float(
-                    roughness.as_ref().unwrap_or(&FloatValue::Value(1.0)),
-                    &format!("{item}.roughness"),
-                    unit,
-                    "in [0, 1]",
-                )?;
-                let occlusion = self.float(
-                    occlusion.as_ref().unwrap_or(&FloatValue::Value(1.0)),
-                    &format!("{item}.occlusion"),
-                    unit,
-                    "in [0, 1]",
-                )?;
-                let anisotropy = self.float(
-                    anisotropy.as_ref().unwrap_or(&FloatValue::Value(0.0)),
-                    &format!("{item}.anisotropy"),
-                    unit,
-                    "in [0, 1]",
-                )?;
+                // The scalar parameters of pbr all lie in [0, 1].
+                let mut unit = |value: &Option<FloatValue>, default: f32, key: &str| {
+                    let fallback = FloatValue::Value(default);
+                    let value = value.as_ref().unwrap_or(&fallback);
+                    self.float(value, &format!("{item}.{key}"), |x| (0.0..=1.0).contains(&x), "in [0, 1]")
+                };
+                let metallic = unit(metallic, 1.0, "metallic")?;
+                let roughness = unit(roughness, 1.0, "roughness")?;
+                let occlusion = unit(occlusion, 1.0, "occlusion")?;
+                let anisotropy = unit(anisotropy, 0.0, "anisotropy")?;
                 let anisotropy_direction = anisotropy_direction
                     .as_ref()
                     .map(|n| self.texture(n, Role::Data, &format!("{item}.anisotropy_direction")))
