@@ -267,7 +267,12 @@ impl Material {
     /// onto its plane (Mitsuba's `normalmap`).
     pub fn shading(&self, textures: &[Texture], ctx: &TexCtx, base: Frame, dpdu: Vec3, dpdv: Vec3) -> Shading {
         let base = match self.texture_frame.and_then(|id| textures[id.0 as usize].tangent_direction(ctx.uv)) {
-            Some((direction, reversed)) => base.turned_towards(dpdu * direction.x + dpdv * direction.y, reversed),
+            Some((direction, f_reversed)) => {
+                // The exemplar's frame reaches the surface through J F^-1: mirrored when exactly
+                // one of F and the UV map (as seen from this side) reverses orientation.
+                let uv_mirrored = dpdu.cross(dpdv).dot(base.n) < 0.0;
+                base.turned_towards(dpdu * direction.x + dpdv * direction.y, f_reversed != uv_mirrored)
+            }
             None => base,
         };
         let base = match &self.kind {

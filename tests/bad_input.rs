@@ -254,7 +254,17 @@ fn bad_tiling_and_blending_textures_are_named() {
         tessera::image::write_exr(&p, 2, 2, channels).unwrap();
         std::fs::read(&p).unwrap()
     };
-    let files: &[(&str, &[u8])] = &[("e.png", &png), ("f.exr", &three_channel_exr), ("n.exr", &nan_exr)];
+    // A cut map whose cell channel holds 2.5, not a cell number.
+    let fractional_cell_exr = {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("c.exr");
+        let planes = [vec![2.5f32, 0.0, 0.0, 0.0], vec![0.5; 4], vec![0.5; 4], vec![1.0; 4]];
+        let channels = ["R", "G", "B", "A"].iter().zip(planes).map(|(c, p)| (c.to_string(), p)).collect();
+        tessera::image::write_exr(&p, 2, 2, channels).unwrap();
+        std::fs::read(&p).unwrap()
+    };
+    let files: &[(&str, &[u8])] =
+        &[("e.png", &png), ("f.exr", &three_channel_exr), ("n.exr", &nan_exr), ("c.exr", &fractional_cell_exr)];
     let with = |tb: &str, extra: &str| {
         format!(
             "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n{extra}\
@@ -292,6 +302,9 @@ fn bad_tiling_and_blending_textures_are_named() {
         files,
         &["n.exr", "NaN", "textures.tb.deformation[0]"],
     );
+    error_of(&with("exemplar = \"e\"\ncuts = \"f.exr\"", ""), files, &["f.exr", "4 channels", "textures.tb.cuts"]);
+    error_of(&with("exemplar = \"e\"\ncuts = \"n.exr\"", ""), files, &["n.exr", "NaN", "textures.tb.cuts"]);
+    error_of(&with("exemplar = \"e\"\ncuts = \"c.exr\"", ""), files, &["c.exr", "2.5", "textures.tb.cuts"]);
     error_of(
         &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"none.exr\" }]", ""),
         files,

@@ -55,7 +55,7 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
         Orientation::Geodesic(vec![Vec3::ZERO]),
     ] {
         for scale in [1.0f32, 0.5] {
-            let maps = deformation_maps(&cylinder_strip(scale), &orientation, 32, 64).unwrap();
+            let maps = deformation_maps(&cylinder_strip(scale), &orientation, 32, 64, 0.25).unwrap();
             assert_eq!(maps.degenerate, 0);
             // F = R(theta) S with S = I / scale: F^T F = I / scale^2, det F = 1 / scale^2.
             for f in each_f(&maps.f_map) {
@@ -69,7 +69,7 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
         }
     }
     // With the UV orientation F is S alone: the identity here.
-    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Uv, 32, 64).unwrap();
+    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Uv, 32, 64, 0.25).unwrap();
     assert!(each_f(&maps.f_map).all(|f| (f - Mat2::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 2e-3)));
 }
 
@@ -77,7 +77,7 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
 fn fixed_orientation_lays_the_texture_along_the_direction() {
     // On the strip, the texture's x axis on the surface (J F^-1 e1, J = [dp/du dp/dv]) must run
     // along y, the cylinder's axis, which in this UV map is +v: so F^-1 e1 is along +v.
-    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Fixed(Vec3::Y), 32, 64).unwrap();
+    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Fixed(Vec3::Y), 32, 64, 0.25).unwrap();
     for f in each_f(&maps.f_map) {
         let along = (f.inverse() * Vec2::X).normalize();
         assert!(along.distance(Vec2::Y) < 1e-3, "{along}");
@@ -94,31 +94,22 @@ fn degenerate_triangles_are_counted_and_filled() {
     uvs[c as usize] = uvs[a as usize];
     let [d, e, _] = mesh.indices[100];
     mesh.positions[e as usize] = mesh.positions[d as usize];
-    let maps = deformation_maps(&mesh, &Orientation::Uv, 32, 64).unwrap();
+    let maps = deformation_maps(&mesh, &Orientation::Uv, 32, 64, 0.25).unwrap();
     assert!(maps.degenerate >= 2, "{}", maps.degenerate);
     assert!(maps.f_map.data.iter().all(|v| v.is_finite()));
     // A mesh without UVs, or with every triangle degenerate, is an error, not a panic.
     let mut no_uv = cylinder_strip(1.0);
     no_uv.uvs = None;
-    assert!(deformation_maps(&no_uv, &Orientation::Uv, 8, 8).is_err());
+    assert!(deformation_maps(&no_uv, &Orientation::Uv, 8, 8, 0.25).is_err());
     let mut flat = cylinder_strip(1.0);
     flat.uvs.as_mut().unwrap().iter_mut().for_each(|u| *u = Vec2::splat(0.5));
-    assert!(deformation_maps(&flat, &Orientation::Uv, 8, 8).is_err());
+    assert!(deformation_maps(&flat, &Orientation::Uv, 8, 8, 0.25).is_err());
 }
 
 #[test]
 fn cli_writes_the_f_map_and_pictures() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = cylinder_strip(1.0);
-    let uvs = mesh.uvs.as_ref().unwrap();
-    let mut obj = String::new();
-    for (p, t) in mesh.positions.iter().zip(uvs) {
-        obj += &format!("v {} {} {}\nvt {} {}\n", p.x, p.y, p.z, t.x, t.y);
-    }
-    for [a, b, c] in &mesh.indices {
-        obj += &format!("f {0}/{0} {1}/{1} {2}/{2}\n", a + 1, b + 1, c + 1);
-    }
-    std::fs::write(dir.path().join("strip.obj"), obj).unwrap();
+    std::fs::write(dir.path().join("strip.obj"), common::obj_text(&cylinder_strip(1.0))).unwrap();
     let out = dir.path().join("maps");
     let run = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
         .arg("deform")
@@ -130,7 +121,11 @@ fn cli_writes_the_f_map_and_pictures() {
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let f = tessera::image::read_bitmap(&out.join("f_map.exr"), tessera::image::ColorSpace::Linear).unwrap();
     assert_eq!((f.width, f.height, f.channels), (32, 32, 4));
-    assert!(out.join("det_f.png").exists() && out.join("orientation.png").exists());
+    assert!(out.join("det_f.png").exists() && out.join("orientation.png").exists() && out.join("cells.png").exists());
+    // One chart, no cuts: an empty cut map.
+    let cuts = tessera::image::read_bitmap_raw(&out.join("cut_map.exr"), tessera::image::ColorSpace::Linear).unwrap();
+    assert_eq!((cuts.width, cuts.height, cuts.channels), (32, 32, 4));
+    assert!(cuts.data.iter().all(|&v| v == 0.0));
     let bad = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
         .arg("deform")
         .arg(dir.path().join("strip.obj"))
@@ -148,7 +143,7 @@ fn the_field_compensates_a_lat_long_sphere_distortion() {
     // anisotropic and its scale varies with latitude; the deformation field (as the renderer
     // reads the F map) makes it nearly conformal and uniform.
     let mesh = tessera::geometry::shapes::uv_sphere(64, 32);
-    let maps = deformation_maps(&mesh, &Orientation::Uv, 64, 256).unwrap();
+    let maps = deformation_maps(&mesh, &Orientation::Uv, 64, 256, 0.25).unwrap();
     let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map));
     let classical = tessera::deform::distortion(&mesh, |_| Mat2::IDENTITY).unwrap();
     let deformed = tessera::deform::distortion(&mesh, |uv| f.at(uv)).unwrap();
@@ -164,7 +159,7 @@ fn geodesic_orientation_runs_away_from_the_source() {
     // along the arc, so the texture's x axis must point along +u where the strip is long.
     let strip = cylinder_strip(1.0);
     let source = Vec3::new(0.5, 0.4, 0.0);
-    let maps = deformation_maps(&strip, &Orientation::Geodesic(vec![source]), 32, 64).unwrap();
+    let maps = deformation_maps(&strip, &Orientation::Geodesic(vec![source]), 32, 64, 0.25).unwrap();
     let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map));
     // At the middle height, beyond the first third of the strip: away from the source is +u.
     for u in [0.5f32, 0.7, 0.85] {
@@ -179,7 +174,7 @@ fn a_scene_reads_the_written_f_map_as_the_grid_gives_it() {
     // Eq. 7 says at the map's texel centres (where the renderer's bilinear lookup is exact).
     // Its entries are signed (here F = -I where theta = pi): nothing may clamp them on load.
     let strip = cylinder_strip(1.0);
-    let maps = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), 16, 32).unwrap();
+    let maps = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), 16, 32, 0.25).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let f = &maps.f_map;
     let plane = |c: usize| f.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();

@@ -67,6 +67,7 @@ fn synthesis(tiling: Tiling, blend: Blend, deformation: Option<Vec<Deformation>>
         tile_size: 0.25,
         seed: 3,
         deformation: deformation.map(DeformationField::new),
+        cuts: None,
         blend,
         inset: false,
     })
@@ -319,6 +320,7 @@ fn footprint_is_f_times_the_pixel_footprint_as_finite_differences_say() {
             tile_size: 0.25,
             seed: 1,
             deformation: Some(DeformationField::new(vec![field])),
+            cuts: None,
             blend: Blend::Linear,
             inset: false,
         };
@@ -516,6 +518,7 @@ fn inset_shifts_keep_tiles_inside_a_non_tileable_exemplar() {
             tile_size: 0.2,
             seed: 5,
             deformation: Some(DeformationField::new(vec![Deformation::Constant(f)])),
+            cuts: None,
             blend: Blend::Linear,
             inset: true,
         };

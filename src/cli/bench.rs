@@ -229,6 +229,7 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
                 tile_size: 0.25,
                 seed: 1,
                 deformation,
+                cuts: None,
                 blend: blend.clone(),
                 inset: false,
             };
@@ -257,7 +258,7 @@ fn deform(runs: usize) -> Result<()> {
     let mut times = Vec::new();
     for _ in 0..runs {
         let start = Instant::now();
-        let maps = tessera::deform::deformation_maps(&mesh, &orientation, 256, 1024)
+        let maps = tessera::deform::deformation_maps(&mesh, &orientation, 256, 1024, 0.25)
             .map_err(|msg| Error::param("bench deform", msg))?;
         std::hint::black_box(maps.f_map.data.len());
         times.push(start.elapsed().as_secs_f64());

@@ -2,6 +2,7 @@
 //! library does the work and reports progress through a callback.
 
 mod bench;
+mod deform;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -119,26 +120,30 @@ enum Command {
         #[arg(long, default_value = "texel")]
         footprint: FootprintArg,
     },
-    /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and write it as an F
-    /// map (f_map.exr: F00, F01, F10, F11) with pictures of |det F| and of the orientation.
+    /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and its UV cuts'
+    /// boundary cells (Sec. 5): writes f_map.exr (F00, F01, F10, F11), cut_map.exr (cell + 1,
+    /// b.x, b.y, sigma) and pictures of |det F|, the orientation and the cells.
     Deform {
-        /// The mesh (OBJ with texture coordinates).
-        mesh: PathBuf,
-        /// Vertices per side of the smoothing grid over the UV square (Eq. 7).
-        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=8192))]
-        grid: u32,
-        /// Texels per side of the F map.
-        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
-        res: u32,
-        /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected
-        /// on the surface), `parallels:X,Y,Z` (circles around an axis through the origin) or
-        /// `geodesic:X,Y,Z[;X,Y,Z...]` (away from the vertices nearest to these points, along the
-        /// gradient of the distance over the surface).
-        #[arg(long, default_value = "uv")]
-        orientation: String,
+        #[command(flatten)]
+        mesh: deform::MeshArgs,
         /// Output folder (created).
         #[arg(short, long)]
         output: PathBuf,
+    },
+    /// Print the distortion and seam metrics of tiling and blending on a mesh, classical
+    /// against deformed, with and without Eq. 8 at the cuts.
+    Analyze {
+        #[command(flatten)]
+        mesh: deform::MeshArgs,
+        /// The exemplar image the seam metric synthesises.
+        #[arg(long)]
+        exemplar: PathBuf,
+        /// Seed of the tiles' shifts.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Point pairs per cut edge for the seam metric.
+        #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        samples: u32,
     },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
@@ -156,88 +161,6 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures", "deform"])]
         only: Vec<bench::Suite>,
     },
-}
-
-/// Parse `uv`, `fixed:X,Y,Z`, `parallels:X,Y,Z` or `geodesic:X,Y,Z[;X,Y,Z...]`.
-fn parse_orientation(text: &str) -> Result<tessera::deform::Orientation> {
-    use tessera::deform::Orientation;
-    let bad = || {
-        Error::param(
-            "--orientation",
-            format!("'{text}': expected uv, fixed:X,Y,Z, parallels:X,Y,Z or geodesic:X,Y,Z[;X,Y,Z...]"),
-        )
-    };
-    if text == "uv" {
-        return Ok(Orientation::Uv);
-    }
-    let (kind, vectors) = text.split_once(':').ok_or_else(bad)?;
-    let points = vectors
-        .split(';')
-        .map(|v| {
-            let c: Vec<f32> =
-                v.split(',').map(|x| x.trim().parse::<f32>()).collect::<std::result::Result<_, _>>().ok()?;
-            let [x, y, z] = c[..] else { return None };
-            Some(glam::Vec3::new(x, y, z)).filter(|p| p.is_finite())
-        })
-        .collect::<Option<Vec<_>>>()
-        .ok_or_else(bad)?;
-    let single = || match points[..] {
-        [d] if d.length_squared() > 0.0 => Ok(d),
-        _ => Err(bad()),
-    };
-    match kind {
-        "fixed" => Ok(Orientation::Fixed(single()?)),
-        "parallels" => Ok(Orientation::Parallels(single()?.normalize())),
-        "geodesic" => Ok(Orientation::Geodesic(points)),
-        _ => Err(bad()),
-    }
-}
-
-/// `tessera deform`.
-fn deform(mesh_path: &Path, grid: usize, res: usize, orientation: &str, output: &Path) -> Result<ExitCode> {
-    let orientation = parse_orientation(orientation)?;
-    let start = Instant::now();
-    let mesh = tessera::geometry::obj::load_obj(mesh_path)?;
-    let loaded = start.elapsed().as_secs_f64();
-    let maps =
-        tessera::deform::deformation_maps(&mesh, &orientation, grid, res).map_err(|msg| Error::mesh(mesh_path, msg))?;
-    let computed = start.elapsed().as_secs_f64() - loaded;
-    std::fs::create_dir_all(output).map_err(|e| Error::io(output, e))?;
-    let f = &maps.f_map;
-    let plane = |c: usize| f.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
-    let channels = ["R", "G", "B", "A"].iter().enumerate().map(|(c, name)| (name.to_string(), plane(c))).collect();
-    tessera::image::write_exr(&output.join("f_map.exr"), f.width, f.height, channels)?;
-    let (det, orientation_picture) = tessera::deform::f_map_pictures(f);
-    write_image(&output.join("det_f.png"), &det, &[])?;
-    write_image(&output.join("orientation.png"), &orientation_picture, &[])?;
-    // Distortion of the texture on the surface, as the renderer reads the written F map.
-    let f_texture =
-        tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map.clone()));
-    let classical = tessera::deform::distortion(&mesh, |_| glam::Mat2::IDENTITY);
-    let deformed = tessera::deform::distortion(&mesh, |uv| f_texture.at(uv));
-    if let (Some(c), Some(d)) = (classical, deformed) {
-        eprintln!(
-            "distortion over {} triangles (area-weighted): mean sigma_max/sigma_min classical {:.3}, deformed {:.3}; \
-             std of ln(sigma_1 sigma_2) classical {:.3}, deformed {:.3}",
-            c.triangles, c.mean_anisotropy, d.mean_anisotropy, c.std_log_area, d.std_log_area
-        );
-    }
-    if maps.degenerate > 0 {
-        eprintln!(
-            "warning: {}: {} triangles are degenerate in 3D or in UV; their grid samples take the nearest triangle's values",
-            mesh_path.display(),
-            maps.degenerate
-        );
-    }
-    eprintln!(
-        "{}: {} triangles ({} mirrored in UV), grid {grid}x{grid} ({} samples outside every triangle, filled from the nearest), F map {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; wrote f_map.exr, det_f.png, orientation.png to {}",
-        mesh_path.display(),
-        mesh.indices.len(),
-        maps.mirrored,
-        maps.grid.filled,
-        output.display()
-    );
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Footprints of `tessera bake`.
@@ -302,9 +225,8 @@ pub fn run() -> Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Command::Deform { mesh, grid, res, orientation, output } => {
-            deform(&mesh, grid as usize, res as usize, &orientation, &output)
-        }
+        Command::Deform { mesh, output } => deform::deform(&mesh, &output),
+        Command::Analyze { mesh, exemplar, seed, samples } => deform::analyze(&mesh, &exemplar, seed, samples as usize),
         Command::Bench { runs, threads, scenes, only } => {
             if runs == 0 {
                 return Err(Error::param("--runs", "must be at least 1"));

@@ -11,7 +11,7 @@
 use crate::geometry::TriangleMesh;
 use glam::Vec3;
 use std::cmp::Ordering;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 
 /// A heap entry ordered by smallest distance first.
 #[derive(PartialEq)]
@@ -34,20 +34,7 @@ impl PartialOrd for Entry {
 /// Distance over the surface of every vertex of `mesh` from the vertices nearest to `sources`
 /// (infinite where unreachable).
 pub fn surface_distances(mesh: &TriangleMesh, sources: &[Vec3]) -> Vec<f32> {
-    // Weld: one id per distinct position.
-    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
-    let welded: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            let next = ids.len() as u32;
-            *ids.entry(p.to_array().map(f32::to_bits)).or_insert(next)
-        })
-        .collect();
-    let mut points = vec![Vec3::ZERO; ids.len()];
-    for (i, &w) in welded.iter().enumerate() {
-        points[w as usize] = mesh.positions[i];
-    }
+    let (welded, points) = mesh.welded_vertices();
     let triangles: Vec<[u32; 3]> = mesh.indices.iter().map(|t| t.map(|i| welded[i as usize])).collect();
     let mut incident: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
     for (k, t) in triangles.iter().enumerate() {

@@ -45,13 +45,28 @@ impl TriangleDeformation {
         Some(TriangleDeformation { rotation, stretch })
     }
 
-    /// The angle theta of F = R(theta) S (Eq. 6 and Sec. 4.3) that turns the texture's own x axis
-    /// onto the tangent `direction`: the texture's x axis reaches the surface along
-    /// J F^-1 e1 = R R(-theta) e1, which is along `direction` when theta = -angle of
-    /// R^-1 direction from e1. Zero when `direction` has no part in the triangle's plane.
+    /// Whether the triangle's UVs are mirrored (R is a reflection).
+    pub fn mirrored(&self) -> bool {
+        self.rotation.determinant() < 0.0
+    }
+
+    /// The stretch with the mirror M = diag(1, -1) in front where the UVs are mirrored: M S.
+    /// F = R(theta) M S then undoes the mirror, so that J F^-1 = R M R(-theta) is a rotation of
+    /// the exemplar's frame onto the surface and the texture never shows mirrored (det F < 0
+    /// there; DESIGN.md section 5).
+    pub fn signed_stretch(&self) -> Mat2 {
+        if self.mirrored() { Mat2::from_diagonal(Vec2::new(1.0, -1.0)) * self.stretch } else { self.stretch }
+    }
+
+    /// The angle theta of F = R(theta) [M] S (Eq. 6 and Sec. 4.3; M where the UVs are mirrored)
+    /// that turns the texture's own x axis onto the tangent `direction`: the x axis reaches the
+    /// surface along J F^-1 e1 = R [M] R(-theta) e1, which is along `direction` when
+    /// theta = -angle of [M] R^-1 direction from e1. Zero when `direction` has no part in the
+    /// triangle's plane.
     pub fn orientation_angle(&self, direction: Vec3) -> f32 {
         let local = self.rotation.transpose() * direction;
-        if local.truncate().length_squared() > 1e-20 { -local.y.atan2(local.x) } else { 0.0 }
+        let y = if self.mirrored() { -local.y } else { local.y };
+        if local.truncate().length_squared() > 1e-20 { -y.atan2(local.x) } else { 0.0 }
     }
 }
 
@@ -95,11 +110,35 @@ mod tests {
         let n = (x[1] - x[0]).cross(x[2] - x[0]).normalize();
         for direction in [Vec3::X, Vec3::new(0.3, -1.0, 0.2), Vec3::Y + Vec3::Z] {
             let theta = d.orientation_angle(direction);
-            let f = Mat2::from_angle(theta) * d.stretch;
+            let f = Mat2::from_angle(theta) * d.signed_stretch();
             let along = f.inverse() * Vec2::X;
             let on_surface = (j * along.extend(0.0)).normalize();
             let tangent = (direction - n * n.dot(direction)).normalize();
             assert!(on_surface.distance(tangent) < 1e-4, "{on_surface} vs {tangent}");
+        }
+    }
+
+    #[test]
+    fn mirrored_uvs_get_a_mirrored_f_and_an_unmirrored_texture() {
+        // The same triangle with its UVs mirrored (v -> -v): the texture must still reach the
+        // surface with its x axis along the direction and its y axis on the side n x x.
+        let u = [Vec2::new(0.1, -0.2), Vec2::new(0.5, -0.3), Vec2::new(0.2, -0.6)];
+        let x = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.2, 0.3), Vec3::new(-0.2, 0.9, 0.4)];
+        let d = TriangleDeformation::new(x, u).unwrap();
+        assert!(d.mirrored());
+        let j = deformation_gradient(x, u).unwrap();
+        let n = (x[1] - x[0]).cross(x[2] - x[0]).normalize();
+        for direction in [Vec3::X, Vec3::new(0.3, -1.0, 0.2)] {
+            let f = Mat2::from_angle(d.orientation_angle(direction)) * d.signed_stretch();
+            assert!(f.determinant() < 0.0);
+            let inverse = f.inverse();
+            let x_axis = j * (inverse * Vec2::X).extend(0.0);
+            let y_axis = j * (inverse * Vec2::Y).extend(0.0);
+            let tangent = (direction - n * n.dot(direction)).normalize();
+            assert!(x_axis.normalize().distance(tangent) < 1e-4, "{x_axis} vs {tangent}");
+            // A similarity onto the surface, keeping the surface's orientation.
+            assert!(y_axis.normalize().distance(n.cross(x_axis).normalize()) < 1e-4);
+            assert!((x_axis.length() - y_axis.length()).abs() < 1e-4 * x_axis.length());
         }
     }
 }

@@ -4,6 +4,7 @@
 //! the nearest UV triangle. Angles are interpolated as unit vectors (cos, sin), so that
 //! wrapping through +-pi never blends the long way round (DESIGN.md section 5).
 
+use super::nearest::{NONE, distance2_to_segment, propagate_nearest};
 use glam::{Mat2, Vec2};
 
 /// The values a triangle gives the grid: its orientation angle and its stretch.
@@ -11,7 +12,8 @@ use glam::{Mat2, Vec2};
 pub struct FieldSample {
     /// (cos theta, sin theta).
     pub direction: Vec2,
-    /// The stretch S (symmetric 2x2).
+    /// The stretch S (symmetric 2x2), with the mirror diag(1, -1) in front where the UVs are
+    /// mirrored ([`super::TriangleDeformation::signed_stretch`]).
     pub stretch: Mat2,
 }
 
@@ -44,14 +46,7 @@ fn distance2_to_triangle(p: Vec2, t: [Vec2; 3]) -> f32 {
             return 0.0;
         }
     }
-    (0..3)
-        .map(|k| {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            let ab = b - a;
-            let s = ((p - a).dot(ab) / ab.length_squared().max(1e-30)).clamp(0.0, 1.0);
-            (a + ab * s).distance_squared(p)
-        })
-        .fold(f32::INFINITY, f32::min)
+    (0..3).map(|k| distance2_to_segment(p, t[k], t[(k + 1) % 3])).fold(f32::INFINITY, f32::min)
 }
 
 /// Barycentric coordinates of `p` in `t`, None for a degenerate triangle.
@@ -70,7 +65,6 @@ impl FieldGrid {
     /// Sample the triangles' values (`values[i]` for triangle `i`, None for a degenerate one)
     /// on an n x n grid. None when no triangle has a value.
     pub fn new(n: usize, uv_triangles: &[[Vec2; 3]], values: &[Option<FieldSample>]) -> Option<Self> {
-        const NONE: u32 = u32::MAX;
         let mut owner = vec![NONE; n * n];
         let point = |i: usize, j: usize| Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / n as f32;
         for (t, tri) in uv_triangles.iter().enumerate() {
@@ -100,38 +94,11 @@ impl FieldGrid {
             let (i, j) = ((centre * n as f32).floor().clamp(Vec2::ZERO, Vec2::splat(n as f32 - 1.0))).as_uvec2().into();
             owner[j as usize * n + i as usize] = t as u32;
         }
-        // Nearest triangle for the others: propagate candidates from neighbours in forward and
-        // backward raster sweeps, keeping the triangle nearest to each point (the classic
-        // two-pass distance transform, with exact point-to-triangle distances).
-        let mut best = vec![f32::INFINITY; n * n];
-        for (k, o) in owner.iter().enumerate() {
-            if *o != NONE {
-                best[k] = 0.0;
-            }
-        }
-        for pass in 0..4 {
-            let forward = pass % 2 == 0;
-            for step in 0..n * n {
-                let k = if forward { step } else { n * n - 1 - step };
-                let (i, j) = ((k % n) as i64, (k / n) as i64);
-                let d = if forward { -1 } else { 1 };
-                for (di, dj) in [(d, 0), (0, d), (d, d), (-d, d)] {
-                    let (ni, nj) = (i + di, j + dj);
-                    if ni < 0 || nj < 0 || ni >= n as i64 || nj >= n as i64 {
-                        continue;
-                    }
-                    let candidate = owner[nj as usize * n + ni as usize];
-                    if candidate == NONE || candidate == owner[k] || best[k] == 0.0 {
-                        continue;
-                    }
-                    let dist = distance2_to_triangle(point(i as usize, j as usize), uv_triangles[candidate as usize]);
-                    if dist < best[k] {
-                        best[k] = dist;
-                        owner[k] = candidate;
-                    }
-                }
-            }
-        }
+        // Nearest triangle for the others.
+        let mut best: Vec<f32> = owner.iter().map(|&o| if o == NONE { f32::INFINITY } else { 0.0 }).collect();
+        propagate_nearest(n, &mut owner, &mut best, |i, j, t| {
+            distance2_to_triangle(point(i, j), uv_triangles[t as usize])
+        });
         let samples = owner.iter().map(|&o| values[o as usize].expect("owners have values")).collect();
         Some(FieldGrid { n, samples, owner, filled: n * n - covered })
     }

@@ -3,14 +3,19 @@
 //! tangent field, the grid smoothing of Eq. 7, and the F map that a tiling-and-blending texture
 //! reads (`deformation = [{ type = "map", ... }]`).
 
+mod cuts;
 mod distortion;
 mod geodesic;
 mod gradient;
 mod grid;
+mod nearest;
+mod seams;
 
+pub use cuts::{BoundaryCell, CutEdge, Cuts};
 pub use distortion::{Distortion, distortion};
 pub use gradient::{TriangleDeformation, deformation_gradient};
 pub use grid::{FieldGrid, FieldSample};
+pub use seams::{channel_std, seam_metric};
 
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
@@ -65,6 +70,11 @@ pub struct DeformationMaps {
     /// The F map: `res` x `res`, 4 channels (F00, F01, F10, F11), row 0 at the top (v = 1), as
     /// image textures are laid out, sampled at texel centres from the grid (Eq. 7).
     pub f_map: Bitmap,
+    /// The UV cuts and their boundary cells (Sec. 5).
+    pub cuts: Cuts,
+    /// The cut map: `res` x `res`, 4 channels (l + 1, b.x, b.y, sigma), row 0 at the top
+    /// ([`Cuts::cut_map`]).
+    pub cut_map: Bitmap,
     /// Triangles skipped because they are degenerate in 3D or in UV.
     pub degenerate: usize,
     /// Triangles whose UVs are mirrored (R is a reflection there).
@@ -72,16 +82,23 @@ pub struct DeformationMaps {
 }
 
 /// Derive the deformation field of `mesh` (which must have UVs): F = R(theta) S per triangle,
-/// smoothed on a `grid` x `grid` grid, written as a `res` x `res` F map.
+/// smoothed on a `grid` x `grid` grid, written as a `res` x `res` F map; and the cut map for
+/// tiles of lattice spacing `tile_size` (cells longer than a tile's diameter, 2 `tile_size`,
+/// on both sides; bands as wide as the square tiling's support radius, sqrt 2 `tile_size`, so
+/// that every tile reaching a cut is centred in its band for either tiling).
 pub fn deformation_maps(
     mesh: &TriangleMesh,
     orientation: &Orientation,
     grid: usize,
     res: usize,
+    tile_size: f32,
 ) -> Result<DeformationMaps, String> {
     let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
     if grid == 0 || res == 0 {
         return Err("the grid and the map need at least one sample per side".into());
+    }
+    if !(tile_size > 0.0 && tile_size.is_finite()) {
+        return Err(format!("the tile size must be a positive UV length, not {tile_size}"));
     }
     let mut degenerate = 0;
     let mut mirrored = 0;
@@ -99,11 +116,11 @@ pub fn deformation_maps(
                 degenerate += 1;
                 return None;
             };
-            if d.rotation.determinant() < 0.0 {
+            if d.mirrored() {
                 mirrored += 1;
             }
             let theta = direction.map_or(0.0, |o| d.orientation_angle(o));
-            Some(FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch })
+            Some(FieldSample { direction: Vec2::from_angle(theta), stretch: d.signed_stretch() })
         })
         .collect();
     let grid = FieldGrid::new(grid, &uv_triangles, &values).ok_or("every triangle is degenerate")?;
@@ -115,7 +132,9 @@ pub fn deformation_maps(
             px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
         }
     }
-    Ok(DeformationMaps { grid, f_map, degenerate, mirrored })
+    let cuts = Cuts::new(mesh, 2.0 * tile_size);
+    let cut_map = cuts.cut_map(res, std::f32::consts::SQRT_2 * tile_size, |uv| grid.at(uv));
+    Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored })
 }
 
 /// Pictures of an F map for people to look at: log2 |det F| as grey (0.5 at 1, black at 1/16,
@@ -134,4 +153,18 @@ pub fn f_map_pictures(f_map: &Bitmap) -> (Bitmap, Bitmap) {
         orientation.data[k * 3..k * 3 + 3].copy_from_slice(&colour.map(|c| c * c));
     }
     (det, orientation)
+}
+
+/// A picture of a cut map: each boundary cell in its own colour (the same on both sides of the
+/// cut), black outside the bands.
+pub fn cut_map_picture(cut_map: &Bitmap) -> Bitmap {
+    let mut picture = Bitmap::new(cut_map.width, cut_map.height, 3);
+    for (k, texel) in cut_map.data.chunks_exact(4).enumerate() {
+        if texel[0] > 0.0 {
+            let bits = crate::sampling::mix64(texel[0] as u64);
+            let colour = [0, 16, 32].map(|s| 0.15 + 0.85 * ((bits >> s) & 0xffff) as f32 / 65535.0);
+            picture.data[k * 3..k * 3 + 3].copy_from_slice(&colour);
+        }
+    }
+    picture
 }

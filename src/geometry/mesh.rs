@@ -65,6 +65,25 @@ pub struct MeshCleanup {
 }
 
 impl TriangleMesh {
+    /// Vertices welded by exact position: for each vertex the id of its position, and the
+    /// distinct positions. Loaders split vertices at UV seams and normal creases; welding joins
+    /// the surface back (geodesic distances, UV cuts).
+    pub fn welded_vertices(&self) -> (Vec<u32>, Vec<Vec3>) {
+        let mut ids: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
+        let mut points = Vec::new();
+        let welded = self
+            .positions
+            .iter()
+            .map(|p| {
+                *ids.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
+                    points.push(*p);
+                    (points.len() - 1) as u32
+                })
+            })
+            .collect();
+        (welded, points)
+    }
+
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.indices.len()

@@ -164,6 +164,10 @@ pub struct TilingBlendingDesc {
     /// The deformation field F as a product of factors, F = F_1 F_2 ... (default: none, which
     /// is classical tiling and blending).
     pub deformation: Option<Vec<DeformationDesc>>,
+    /// A cut map written by `tessera deform` (`cut_map.exr`): tiles centred in a boundary cell
+    /// of a UV cut take the cell's centre and shift, so that the texture continues across the
+    /// cut (paper 000 Eq. 8). Made for the same `tile_size` as `tessera deform --tile-size`.
+    pub cuts: Option<String>,
 }
 
 /// A scale: one number for both axes, or [along u, along v].

@@ -17,7 +17,7 @@ use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
 };
-use crate::texture::tiling_blending::{Blend, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
+use crate::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
 use crate::texture::{ImageTexture, MipMap, Texture, TilingBlending};
 use glam::{Mat2, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
@@ -331,6 +331,7 @@ impl<'a> Loader<'a> {
                 ("lambda", d.lambda.is_some()),
                 ("contrast", d.contrast.is_some()),
                 ("deformation", d.deformation.is_some()),
+                ("cuts", d.cuts.is_some()),
             ];
             if let Some((key, _)) = own.iter().find(|(_, set)| *set) {
                 return Err(
@@ -410,11 +411,21 @@ impl<'a> Loader<'a> {
                     .collect::<Result<_>>()?,
             )),
         };
+        let cuts = match &d.cuts {
+            None => None,
+            Some(filename) => {
+                let file = self.resolve_path(filename);
+                let item = format!("{item}.cuts");
+                let bitmap = read_bitmap_raw(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, &item))?;
+                Some(CutMap::new(&bitmap).map_err(|msg| Error::image(&file, msg).in_scene(self.path, &item))?)
+            }
+        };
         let synthesis = Arc::new(Synthesis {
             tiling: d.tiling.unwrap_or(Tiling::Hexagonal),
             tile_size,
             seed: d.seed.unwrap_or(0),
             deformation,
+            cuts,
             blend,
             inset: !d.tileable.unwrap_or(true),
         });

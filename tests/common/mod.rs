@@ -14,6 +14,19 @@ pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// `mesh` (with UVs) as OBJ text.
+pub fn obj_text(mesh: &tessera::geometry::TriangleMesh) -> String {
+    let uvs = mesh.uvs.as_ref().expect("a mesh with UVs");
+    let mut obj = String::new();
+    for (p, t) in mesh.positions.iter().zip(uvs) {
+        obj += &format!("v {} {} {}\nvt {} {}\n", p.x, p.y, p.z, t.x, t.y);
+    }
+    for [a, b, c] in &mesh.indices {
+        obj += &format!("f {0}/{0} {1}/{1} {2}/{2}\n", a + 1, b + 1, c + 1);
+    }
+    obj
+}
+
 /// Write `toml` as `scene.toml` (and `files` beside it) in a fresh temporary folder.
 pub fn scene_dir(toml: &str, files: &[(&str, &[u8])]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("temporary folder");

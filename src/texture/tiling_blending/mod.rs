@@ -7,13 +7,15 @@
 //! material (albedo, roughness, normal, ...) share one `Arc<Synthesis>` so that they all see the
 //! same tiles, shifts and weights and stay registered (paper 000 Sec. 6.2).
 
+mod cuts;
 mod deformation;
 mod histogram;
 mod tiling;
 
+pub use cuts::{CellTexel, CutMap};
 pub use deformation::{Deformation, DeformationField};
 pub use histogram::GaussianizedExemplar;
-pub use tiling::{MAX_TILES, Tile, Tiling, shift};
+pub use tiling::{MAX_TILES, Tile, Tiling, cell_shift, shift};
 
 use super::{ImageTexture, TexCtx, Texture};
 use crate::color::{Rgb, luminance};
@@ -113,6 +115,9 @@ pub struct Synthesis {
     pub seed: u64,
     /// The deformation field F; None is classical tiling and blending (Eq. 2).
     pub deformation: Option<DeformationField>,
+    /// The cut map: tiles centred in a boundary cell take its centre and shift (Eq. 8), so that
+    /// both sides of a UV cut blend the same tiles. None leaves cuts alone.
+    pub cuts: Option<CutMap>,
     /// The blending operator.
     pub blend: Blend,
     /// Keep each tile inside the exemplar's unit square where it fits (for exemplars that do
@@ -145,20 +150,43 @@ impl Synthesis {
 
     /// The tiles' exemplar lookups at `ctx` (Eq. 3; Sec. 6.1 for the footprint). Without a
     /// deformation field the lookup is u - c_i + h_i: Eq. 2 with the shift h_i - c_i, so that
-    /// F = identity reproduces it exactly.
+    /// F = identity reproduces it exactly. With a cut map, a tile centred in boundary cell l
+    /// reads E(F(u) (u - b_l) + h_l) (Eq. 8); tiles of the same cell and side are then the same
+    /// tile, and their weights are summed into the first (the others get weight 0), so that a
+    /// point covered by one cell only reads exactly that cell's tile whatever the operator.
     #[inline]
     pub fn lookups(&self, ctx: &TexCtx) -> [TileLookup; MAX_TILES] {
+        let k = self.tiles_per_point();
         let tiles = self.tiling.tiles(ctx.uv, self.tile_size);
         let f = self.deformation.as_ref().map(|d| d.at(ctx.uv));
         let mut out = [TileLookup::default(); MAX_TILES];
-        for (out, tile) in out.iter_mut().zip(&tiles).take(self.tiles_per_point()) {
-            let offset = ctx.uv - tile.centre;
-            let mut h = shift(tile.vertex, self.seed);
-            if self.inset {
-                h = self.inset_shift(h, tile.centre);
+        let mut cells: [Option<CellTexel>; MAX_TILES] = [None; MAX_TILES];
+        for i in 0..k {
+            let tile = &tiles[i];
+            cells[i] = self.cuts.as_ref().and_then(|c| c.at(tile.centre));
+            let (centre, h) = match cells[i] {
+                Some(cell) => {
+                    let h = cell_shift(cell.cell, self.seed);
+                    (
+                        cell.centre,
+                        if self.inset { inset_shift(h, Vec2::splat(self.cell_reach(cell.stretch))) } else { h },
+                    )
+                }
+                None => {
+                    let h = shift(tile.vertex, self.seed);
+                    (tile.centre, if self.inset { inset_shift(h, self.tile_reach(tile.centre)) } else { h })
+                }
+            };
+            if let Some(cell) = cells[i] {
+                if let Some(first) = (0..i).find(|&j| cells[j] == Some(cell)) {
+                    out[first].weight += tile.weight;
+                    out[i] = TileLookup { weight: 0.0, ..out[first] };
+                    continue;
+                }
             }
-            out.weight = tile.weight;
-            out.ctx = match f {
+            let offset = ctx.uv - centre;
+            out[i].weight = tile.weight;
+            out[i].ctx = match f {
                 None => TexCtx { uv: offset + h, ..*ctx },
                 Some(f) => TexCtx { uv: f * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy },
             };
@@ -166,18 +194,19 @@ impl Synthesis {
         out
     }
 
-    /// A shift `h` uniform over the exemplar's square narrowed, along each axis where the tile
-    /// fits, to the positions that keep the tile (its support's corners through F at its
-    /// centre) inside the square.
-    fn inset_shift(&self, h: Vec2, centre: Vec2) -> Vec2 {
+    /// How far, per axis, a tile centred at `centre` reaches into the exemplar: its support's
+    /// corners through F at its centre.
+    fn tile_reach(&self, centre: Vec2) -> Vec2 {
         let f = self.deformation_at(centre);
-        let reach = self
-            .tiling
-            .support_corners()
-            .iter()
-            .fold(Vec2::ZERO, |r, corner| r.max((f * (*corner * self.tile_size)).abs()));
-        let narrowed = reach + h * (Vec2::ONE - 2.0 * reach);
-        Vec2::select(reach.cmplt(Vec2::splat(0.5)), narrowed, h)
+        self.tiling.support_corners().iter().fold(Vec2::ZERO, |r, corner| r.max((f * (*corner * self.tile_size)).abs()))
+    }
+
+    /// How far a tile of a boundary cell reaches into the exemplar along any axis: its support's
+    /// radius times the cell's largest stretch (the same on both sides of the cut, whose UV
+    /// axes differ).
+    fn cell_reach(&self, stretch: f32) -> f32 {
+        let radius = self.tiling.support_corners().iter().map(|c| c.length()).fold(0.0, f32::max);
+        stretch * radius * self.tile_size
     }
 
     /// The blending weights of the tiles: the paving's for the linear and variance-preserving
@@ -205,14 +234,16 @@ impl Synthesis {
             Blend::MixMax { priority, contrast, lambda } => {
                 let mut score = [f32::NEG_INFINITY; MAX_TILES];
                 let mut variance = [0.0; MAX_TILES];
-                for i in 0..k {
+                // Tiles of weight 0 (merged into another by Eq. 8) take no part.
+                let live = |i: usize| lookups[i].weight > 0.0;
+                for i in (0..k).filter(|&i| live(i)) {
                     let (s, var) = priority.mean_and_variance(&lookups[i].ctx);
                     score[i] = contrast * s + lookups[i].weight.ln();
                     variance[i] = contrast * contrast * var;
                 }
-                for i in 0..k {
+                for i in (0..k).filter(|&i| live(i)) {
                     w[i] = (0..k)
-                        .filter(|&j| j != i)
+                        .filter(|&j| j != i && live(j))
                         .map(|j| {
                             win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda)
                         })
@@ -239,6 +270,7 @@ impl Synthesis {
             _ => 0,
         };
         maps + self.deformation.as_ref().map_or(0, |d| d.memory_bytes())
+            + self.cuts.as_ref().map_or(0, |c| c.memory_bytes())
     }
 
     /// True when the weights read a filtered texture.
@@ -249,6 +281,14 @@ impl Synthesis {
             _ => false,
         }
     }
+}
+
+/// A shift `h` uniform over the exemplar's square narrowed, along each axis where the tile fits,
+/// to the positions that keep the tile (reaching `reach` from its centre) inside the square.
+#[inline]
+fn inset_shift(h: Vec2, reach: Vec2) -> Vec2 {
+    let narrowed = reach + h * (Vec2::ONE - 2.0 * reach);
+    Vec2::select(reach.cmplt(Vec2::splat(0.5)), narrowed, h)
 }
 
 /// P(X > 0) for X normal with mean `difference` and variance `variance`; a step (1/2 at 0) when

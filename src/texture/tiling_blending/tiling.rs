@@ -128,7 +128,18 @@ fn square(uv: Vec2, size: f32) -> [Tile; MAX_TILES] {
 /// square (the exemplar repeats with period 1).
 #[inline]
 pub fn shift(vertex: IVec2, seed: u64) -> Vec2 {
-    let key = seed ^ ((vertex.x as u32 as u64) << 32 | vertex.y as u32 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    shift_of_key(seed ^ ((vertex.x as u32 as u64) << 32 | vertex.y as u32 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
+/// The shared shift h_l of the tiles of boundary cell `cell` under `seed` (paper 000 Eq. 8),
+/// drawn like a lattice vertex's from a separate key space.
+#[inline]
+pub fn cell_shift(cell: u32, seed: u64) -> Vec2 {
+    shift_of_key(seed.rotate_left(29) ^ (cell as u64 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93))
+}
+
+#[inline]
+fn shift_of_key(key: u64) -> Vec2 {
     let bits = crate::sampling::mix64(key);
     Vec2::new((bits >> 40) as f32, ((bits >> 16) & 0xff_ffff) as f32) * (1.0 / 16_777_216.0)
 }

@@ -1,0 +1,200 @@
+//! `tessera deform` and `tessera analyze`: the deformation field and cut map of a UV-mapped mesh
+//! (paper 000 Sec. 4 and 5), and the distortion and seam metrics they are judged by.
+
+use clap::Args;
+use glam::{Mat2, Vec3};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Instant;
+use tessera::deform::{DeformationMaps, Orientation, channel_std, deformation_maps, distortion, seam_metric};
+use tessera::error::{Error, Result};
+use tessera::geometry::TriangleMesh;
+use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
+use tessera::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, Synthesis, Tiling};
+use tessera::texture::{Filter, ImageTexture, MipMap, Texture, TilingBlending};
+
+/// The mesh and the parameters of its deformation field.
+#[derive(Args)]
+pub struct MeshArgs {
+    /// The mesh (OBJ with texture coordinates).
+    mesh: PathBuf,
+    /// Vertices per side of the smoothing grid over the UV square (Eq. 7).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    grid: u32,
+    /// Texels per side of the F map and the cut map.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    res: u32,
+    /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected
+    /// on the surface), `parallels:X,Y,Z` (circles around an axis through the origin) or
+    /// `geodesic:X,Y,Z[;X,Y,Z...]` (away from the vertices nearest to these points, along the
+    /// gradient of the distance over the surface).
+    #[arg(long, default_value = "uv")]
+    orientation: String,
+    /// Lattice spacing of the tiles in UV units (the scene's `tile_size`): boundary cells are
+    /// merged until longer than a tile on both sides of the cut.
+    #[arg(long, default_value_t = 0.25)]
+    tile_size: f32,
+}
+
+impl MeshArgs {
+    /// Load the mesh and derive its maps; also says how long each took.
+    fn maps(&self) -> Result<(TriangleMesh, DeformationMaps, [f64; 2])> {
+        if !(self.tile_size > 1e-6 && self.tile_size <= 1e4) {
+            return Err(Error::param("--tile-size", format!("{} is not in (1e-6, 1e4] UV units", self.tile_size)));
+        }
+        let orientation = parse_orientation(&self.orientation)?;
+        let start = Instant::now();
+        let mesh = tessera::geometry::obj::load_obj(&self.mesh)?;
+        let loaded = start.elapsed().as_secs_f64();
+        let maps = deformation_maps(&mesh, &orientation, self.grid as usize, self.res as usize, self.tile_size)
+            .map_err(|msg| Error::mesh(&self.mesh, msg))?;
+        if maps.degenerate > 0 {
+            eprintln!(
+                "warning: {}: {} triangles are degenerate in 3D or in UV; their grid samples take the nearest triangle's values",
+                self.mesh.display(),
+                maps.degenerate
+            );
+        }
+        if maps.cuts.non_manifold > 0 {
+            eprintln!(
+                "warning: {}: {} edges have more than two faces; they are not treated as cuts",
+                self.mesh.display(),
+                maps.cuts.non_manifold
+            );
+        }
+        Ok((mesh, maps, [loaded, start.elapsed().as_secs_f64() - loaded]))
+    }
+}
+
+/// Parse `uv`, `fixed:X,Y,Z`, `parallels:X,Y,Z` or `geodesic:X,Y,Z[;X,Y,Z...]`.
+fn parse_orientation(text: &str) -> Result<Orientation> {
+    let bad = || {
+        Error::param(
+            "--orientation",
+            format!("'{text}': expected uv, fixed:X,Y,Z, parallels:X,Y,Z or geodesic:X,Y,Z[;X,Y,Z...]"),
+        )
+    };
+    if text == "uv" {
+        return Ok(Orientation::Uv);
+    }
+    let (kind, vectors) = text.split_once(':').ok_or_else(bad)?;
+    let points = vectors
+        .split(';')
+        .map(|v| {
+            let c: Vec<f32> =
+                v.split(',').map(|x| x.trim().parse::<f32>()).collect::<std::result::Result<_, _>>().ok()?;
+            let [x, y, z] = c[..] else { return None };
+            Some(Vec3::new(x, y, z)).filter(|p| p.is_finite())
+        })
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(bad)?;
+    let single = || match points[..] {
+        [d] if d.length_squared() > 0.0 => Ok(d),
+        _ => Err(bad()),
+    };
+    match kind {
+        "fixed" => Ok(Orientation::Fixed(single()?)),
+        "parallels" => Ok(Orientation::Parallels(single()?.normalize())),
+        "geodesic" => Ok(Orientation::Geodesic(points)),
+        _ => Err(bad()),
+    }
+}
+
+/// The F map as the renderer reads it (`deformation = [{ type = "map" }]`).
+fn f_map_field(maps: &DeformationMaps) -> DeformationField {
+    DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))])
+}
+
+/// Print the distortion metric, classical against deformed.
+fn print_distortion(mesh: &TriangleMesh, maps: &DeformationMaps) {
+    let field = f_map_field(maps);
+    let classical = distortion(mesh, |_| Mat2::IDENTITY);
+    let deformed = distortion(mesh, |uv| field.at(uv));
+    if let (Some(c), Some(d)) = (classical, deformed) {
+        println!(
+            "distortion over {} triangles (area-weighted): mean sigma_max/sigma_min classical {:.3}, deformed {:.3}; \
+             std of ln(sigma_1 sigma_2) classical {:.3}, deformed {:.3}",
+            c.triangles, c.mean_anisotropy, d.mean_anisotropy, c.std_log_area, d.std_log_area
+        );
+    }
+}
+
+/// `tessera deform`.
+pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
+    let (mesh, maps, [loaded, computed]) = args.maps()?;
+    std::fs::create_dir_all(output).map_err(|e| Error::io(output, e))?;
+    let write_map = |name: &str, map: &tessera::image::Bitmap| {
+        let plane = |c: usize| map.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
+        let channels = ["R", "G", "B", "A"].iter().enumerate().map(|(c, name)| (name.to_string(), plane(c))).collect();
+        write_exr(&output.join(name), map.width, map.height, channels)
+    };
+    write_map("f_map.exr", &maps.f_map)?;
+    write_map("cut_map.exr", &maps.cut_map)?;
+    let (det, orientation_picture) = tessera::deform::f_map_pictures(&maps.f_map);
+    write_image(&output.join("det_f.png"), &det, &[])?;
+    write_image(&output.join("orientation.png"), &orientation_picture, &[])?;
+    write_image(&output.join("cells.png"), &tessera::deform::cut_map_picture(&maps.cut_map), &[])?;
+    print_distortion(&mesh, &maps);
+    let res = args.res;
+    eprintln!(
+        "{}: {} triangles ({} mirrored in UV), grid {g}x{g} ({} samples outside every triangle, filled from the nearest), \
+         {} cut edges in {} boundary cells (tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
+         wrote f_map.exr, cut_map.exr, det_f.png, orientation.png, cells.png to {}",
+        args.mesh.display(),
+        mesh.indices.len(),
+        maps.mirrored,
+        maps.grid.filled,
+        maps.cuts.edges.len(),
+        maps.cuts.cells.len(),
+        args.tile_size,
+        output.display(),
+        g = args.grid,
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `tessera analyze`.
+pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize) -> Result<ExitCode> {
+    let (mesh, maps, _) = args.maps()?;
+    let bitmap = read_bitmap(exemplar_path, ColorSpace::Srgb)?;
+    let spread = channel_std(&bitmap);
+    let exemplar = Arc::new(Texture::Image(ImageTexture {
+        mipmap: Arc::new(MipMap::new(bitmap)),
+        filter: Filter::None,
+        scale: glam::Vec2::ONE,
+        offset: glam::Vec2::ZERO,
+    }));
+    let cut_map = CutMap::new(&maps.cut_map).map_err(|msg| Error::mesh(&args.mesh, msg))?;
+    let texture = |deformation: Option<DeformationField>, cuts: Option<CutMap>| {
+        let synthesis = Synthesis {
+            tiling: Tiling::Hexagonal,
+            tile_size: args.tile_size,
+            seed,
+            deformation,
+            cuts,
+            blend: Blend::Linear,
+            inset: false,
+        };
+        TilingBlending::new(Arc::new(synthesis), exemplar.clone()).map_err(|msg| Error::image(exemplar_path, msg))
+    };
+    print_distortion(&mesh, &maps);
+    if maps.cuts.edges.is_empty() {
+        println!("seams: the mesh has no UV cuts");
+        return Ok(ExitCode::SUCCESS);
+    }
+    let seams = |texture: TilingBlending| seam_metric(&maps.cuts, &texture, spread, samples).unwrap_or(f64::NAN);
+    let classical = seams(texture(None, None)?);
+    let classical_cells = seams(texture(None, Some(cut_map.clone()))?);
+    let deformed = seams(texture(Some(f_map_field(&maps)), None)?);
+    let deformed_cells = seams(texture(Some(f_map_field(&maps)), Some(cut_map))?);
+    println!(
+        "seams over {} cut edges in {} boundary cells (mean |T_left - T_right| / std(exemplar), hexagonal tiles of {}, \
+         linear blending): classical {classical:.4}, classical with Eq. 8 {classical_cells:.4}; deformed {deformed:.4}, \
+         deformed with Eq. 8 {deformed_cells:.4}",
+        maps.cuts.edges.len(),
+        maps.cuts.cells.len(),
+        args.tile_size
+    );
+    Ok(ExitCode::SUCCESS)
+}
