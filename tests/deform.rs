@@ -201,3 +201,57 @@ fn a_scene_reads_the_written_f_map_as_the_grid_gives_it() {
         assert!(direction.normalize().distance(expected) < 1e-4, "at {uv}: {direction} vs {expected}");
     }
 }
+
+#[test]
+fn per_vertex_tangents_orient_like_the_field_they_sample() {
+    // Tangents Y x p at the vertices sum, per triangle, to Y x (3 x centroid): the parallels
+    // field around Y.
+    let strip = cylinder_strip(1.0);
+    let tangents: Vec<Vec3> = strip.positions.iter().map(|p| Vec3::Y.cross(*p)).collect();
+    let given = deformation_maps(&strip, &Orientation::PerVertex(tangents), 16, 32, 0.25).unwrap();
+    let parallels = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), 16, 32, 0.25).unwrap();
+    for (a, b) in given.f_map.data.iter().zip(&parallels.f_map.data) {
+        assert!((a - b).abs() < 1e-4, "{a} vs {b}");
+    }
+    // One tangent per vertex, finite.
+    assert!(deformation_maps(&strip, &Orientation::PerVertex(vec![Vec3::X; 3]), 8, 8, 0.25).is_err());
+}
+
+#[test]
+fn cli_reads_gltf_meshes_and_their_tangents() {
+    let dir = tempfile::tempdir().unwrap();
+    let strip = cylinder_strip(1.0);
+    std::fs::write(dir.path().join("strip.obj"), common::obj_text(&strip)).unwrap();
+    let tangents = vec![Vec3::Y; strip.positions.len()];
+    let (json, bin) = common::gltf_text(&strip, Some(&tangents), "strip.bin");
+    std::fs::write(dir.path().join("strip.gltf"), json).unwrap();
+    std::fs::write(dir.path().join("strip.bin"), bin).unwrap();
+    let (json, bin) = common::gltf_text(&strip, None, "bare.bin");
+    std::fs::write(dir.path().join("bare.gltf"), json).unwrap();
+    std::fs::write(dir.path().join("bare.bin"), bin).unwrap();
+    let deform = |mesh: &str, orientation: &str, out: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+            .arg("deform")
+            .arg(dir.path().join(mesh))
+            .args(["--grid", "16", "--res", "32", "--orientation", orientation, "-o"])
+            .arg(dir.path().join(out))
+            .output()
+            .unwrap()
+    };
+    let read = |out: &str| {
+        tessera::image::read_bitmap_raw(&dir.path().join(out).join("f_map.exr"), tessera::image::ColorSpace::Linear)
+            .unwrap()
+    };
+    for (mesh, orientation, out) in [("strip.gltf", "tangents", "gltf"), ("strip.obj", "fixed:0,1,0", "obj")] {
+        let run = deform(mesh, orientation, out);
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    }
+    // The glTF's UVs (v flipped back on load) and tangents give the OBJ's fixed field.
+    for (a, b) in read("gltf").data.iter().zip(&read("obj").data) {
+        assert!((a - b).abs() < 1e-4, "{a} vs {b}");
+    }
+    let run = deform("bare.gltf", "tangents", "bare");
+    assert!(!run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("bare.gltf") && stderr.contains("TANGENT"), "{stderr}");
+}

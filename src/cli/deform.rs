@@ -17,7 +17,8 @@ use tessera::texture::{Filter, ImageTexture, MipMap, Texture, TilingBlending};
 /// The mesh and the parameters of its deformation field.
 #[derive(Args)]
 pub struct MeshArgs {
-    /// The mesh (OBJ with texture coordinates).
+    /// The mesh with texture coordinates: OBJ, or glTF 2.0 (.gltf, .glb; all its triangle
+    /// primitives in world space).
     mesh: PathBuf,
     /// Vertices per side of the smoothing grid over the UV square (Eq. 7).
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=8192))]
@@ -28,7 +29,8 @@ pub struct MeshArgs {
     /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected
     /// on the surface), `parallels:X,Y,Z` (circles around an axis through the origin) or
     /// `geodesic:X,Y,Z[;X,Y,Z...]` (away from the vertices nearest to these points, along the
-    /// gradient of the distance over the surface).
+    /// gradient of the distance over the surface), or `tangents` (per vertex from a glTF
+    /// file's TANGENT attribute).
     #[arg(long, default_value = "uv")]
     orientation: String,
     /// Lattice spacing of the tiles in UV units (the scene's `tile_size`): boundary cells are
@@ -43,10 +45,19 @@ impl MeshArgs {
         if !(self.tile_size > 1e-6 && self.tile_size <= 1e4) {
             return Err(Error::param("--tile-size", format!("{} is not in (1e-6, 1e4] UV units", self.tile_size)));
         }
-        let orientation = parse_orientation(&self.orientation)?;
         let start = Instant::now();
-        let mesh = tessera::geometry::obj::load_obj(&self.mesh)?;
+        let (mesh, tangents) = tessera::scene::load_surface(&self.mesh)?;
         let loaded = start.elapsed().as_secs_f64();
+        let orientation = match (self.orientation.as_str(), tangents) {
+            ("tangents", Some(tangents)) => Orientation::PerVertex(tangents),
+            ("tangents", None) => {
+                return Err(Error::mesh(
+                    &self.mesh,
+                    "--orientation tangents: the file has no per-vertex tangents (glTF TANGENT)",
+                ));
+            }
+            (text, _) => parse_orientation(text)?,
+        };
         let maps = deformation_maps(&mesh, &orientation, self.grid as usize, self.res as usize, self.tile_size)
             .map_err(|msg| Error::mesh(&self.mesh, msg))?;
         if maps.degenerate > 0 {
@@ -72,7 +83,7 @@ fn parse_orientation(text: &str) -> Result<Orientation> {
     let bad = || {
         Error::param(
             "--orientation",
-            format!("'{text}': expected uv, fixed:X,Y,Z, parallels:X,Y,Z or geodesic:X,Y,Z[;X,Y,Z...]"),
+            format!("'{text}': expected uv, fixed:X,Y,Z, parallels:X,Y,Z, geodesic:X,Y,Z[;X,Y,Z...] or tangents"),
         )
     };
     if text == "uv" {

@@ -33,6 +33,9 @@ pub enum Orientation {
     /// Along the gradient of the distance over the surface from the vertices nearest to these
     /// points (Sec. 6.3): the texture runs away from them.
     Geodesic(Vec<Vec3>),
+    /// Given per vertex (as the mesh's positions are), e.g. a glTF file's TANGENT: each
+    /// triangle takes the sum of its corners' tangents.
+    PerVertex(Vec<Vec3>),
 }
 
 impl Orientation {
@@ -50,6 +53,11 @@ impl Orientation {
                     let x = corners(idx);
                     Some(axis.cross((x[0] + x[1] + x[2]) / 3.0))
                 })
+                .collect(),
+            Orientation::PerVertex(tangents) => mesh
+                .indices
+                .iter()
+                .map(|idx| Some(idx.iter().map(|&i| tangents.get(i as usize).copied().unwrap_or(Vec3::ZERO)).sum()))
                 .collect(),
             Orientation::Geodesic(sources) => {
                 let d = geodesic::surface_distances(mesh, sources);
@@ -96,6 +104,15 @@ pub fn deformation_maps(
     let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
     if grid == 0 || res == 0 {
         return Err("the grid and the map need at least one sample per side".into());
+    }
+    if let Orientation::PerVertex(tangents) = orientation {
+        if tangents.len() != mesh.positions.len() || !tangents.iter().all(|t| t.is_finite()) {
+            return Err(format!(
+                "{} tangents for {} vertices, or some not finite: one finite tangent per vertex is needed",
+                tangents.len(),
+                mesh.positions.len()
+            ));
+        }
     }
     if !(tile_size > 0.0 && tile_size.is_finite()) {
         return Err(format!("the tile size must be a positive UV length, not {tile_size}"));

@@ -77,6 +77,98 @@ pub(super) fn import_camera(path: &Path, index: usize) -> Result<(Mat4, f32)> {
     Ok((m, yfov))
 }
 
+/// A primitive's vertex tangents (glTF TANGENT's xyz), in world space.
+type Tangents = Option<Vec<Vec3>>;
+
+/// Read every triangle primitive of the default scene in world space, with its material index
+/// and its tangents if it has them. An error for a primitive without positions or with a bad
+/// index count, or a scene without triangles.
+fn read_primitives(
+    path: &Path,
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    warnings: &mut Vec<String>,
+    mut f: impl FnMut(TriangleMesh, Option<usize>, Tangents),
+) -> Result<()> {
+    let mut error = None;
+    let mut count = 0;
+    walk_nodes(doc, |node, m| {
+        let Some(mesh) = node.mesh() else { return };
+        for prim in mesh.primitives() {
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                warnings.push(format!("mesh {}: primitive of mode {:?} skipped", mesh.index(), prim.mode()));
+                continue;
+            }
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let Some(positions) = reader.read_positions() else {
+                error.get_or_insert_with(|| {
+                    Error::mesh(path, format!("mesh {}: a primitive has no POSITION", mesh.index()))
+                });
+                continue;
+            };
+            let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
+            let n = positions.len();
+            let indices: Vec<u32> = match reader.read_indices() {
+                Some(i) => i.into_u32().collect(),
+                None => (0..n as u32).collect(),
+            };
+            if indices.len() % 3 != 0 {
+                error.get_or_insert_with(|| {
+                    Error::mesh(path, format!("mesh {}: index count not a multiple of 3", mesh.index()))
+                });
+                continue;
+            }
+            let tangents = reader
+                .read_tangents()
+                .map(|t| t.map(|[x, y, z, _]| m.transform_vector3(Vec3::new(x, y, z))).collect::<Vec<_>>());
+            if tangents.as_ref().is_some_and(|t| t.len() != n) {
+                error.get_or_insert_with(|| {
+                    Error::mesh(path, format!("mesh {}: TANGENT and POSITION counts differ", mesh.index()))
+                });
+                continue;
+            }
+            let mut tri = TriangleMesh {
+                positions,
+                normals: reader.read_normals().map(|it| it.map(Vec3::from).collect()),
+                uvs: reader.read_tex_coords(0).map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect()),
+                indices: indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            };
+            tri.transform(&m);
+            count += 1;
+            f(tri, prim.material().index(), tangents);
+        }
+    });
+    if let Some(e) = error {
+        return Err(e);
+    }
+    if count == 0 {
+        return Err(Error::mesh(path, "the file's scene has no triangle meshes"));
+    }
+    Ok(())
+}
+
+/// The surface of a glTF file for `tessera deform`: all its triangle primitives in world space
+/// as one mesh, with their per-vertex tangents (glTF TANGENT) where every primitive has them.
+pub(super) fn import_surface(path: &Path) -> Result<(TriangleMesh, Option<Vec<Vec3>>)> {
+    let (doc, buffers, _) = import(path)?;
+    let mut surface = TriangleMesh { uvs: Some(Vec::new()), ..TriangleMesh::default() };
+    let mut tangents = Some(Vec::new());
+    read_primitives(path, &doc, &buffers, &mut Vec::new(), |mesh, _, t| {
+        let base = surface.positions.len() as u32;
+        match (&mut surface.uvs, mesh.uvs) {
+            (Some(all), Some(uvs)) => all.extend(uvs),
+            (uvs, _) => *uvs = None,
+        }
+        match (&mut tangents, t) {
+            (Some(all), Some(t)) => all.extend(t),
+            (t, _) => *t = None,
+        }
+        surface.positions.extend(mesh.positions);
+        surface.indices.extend(mesh.indices.iter().map(|i| i.map(|v| v + base)));
+    })?;
+    Ok((surface, tangents))
+}
+
 /// Convert a decoded glTF image to a bitmap in the given colour space.
 fn bitmap(data: &gltf::image::Data, space: ColorSpace) -> Bitmap {
     use gltf::image::Format;
@@ -200,48 +292,8 @@ pub(super) fn import_meshes(
         materials.push(material);
     }
     let mut meshes = Vec::new();
-    let mut error = None;
-    walk_nodes(&doc, |node, m| {
-        let Some(mesh) = node.mesh() else { return };
-        for prim in mesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                warnings.push(format!("mesh {}: primitive of mode {:?} skipped", mesh.index(), prim.mode()));
-                continue;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let Some(positions) = reader.read_positions() else {
-                error.get_or_insert_with(|| {
-                    Error::mesh(path, format!("mesh {}: a primitive has no POSITION", mesh.index()))
-                });
-                continue;
-            };
-            let positions: Vec<Vec3> = positions.map(Vec3::from).collect();
-            let n = positions.len();
-            let indices: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..n as u32).collect(),
-            };
-            if indices.len() % 3 != 0 {
-                error.get_or_insert_with(|| {
-                    Error::mesh(path, format!("mesh {}: index count not a multiple of 3", mesh.index()))
-                });
-                continue;
-            }
-            let mut tri = TriangleMesh {
-                positions,
-                normals: reader.read_normals().map(|it| it.map(Vec3::from).collect()),
-                uvs: reader.read_tex_coords(0).map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect()),
-                indices: indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-            };
-            tri.transform(&m);
-            meshes.push((tri, prim.material().index().map(|i| first_material + i as u32)));
-        }
-    });
-    if let Some(e) = error {
-        return Err(e);
-    }
-    if meshes.is_empty() {
-        return Err(Error::mesh(path, "the file's scene has no triangle meshes"));
-    }
+    read_primitives(path, &doc, &buffers, &mut warnings, |mesh, material, _| {
+        meshes.push((mesh, material.map(|i| first_material + i as u32)));
+    })?;
     Ok(GltfImport { meshes, warnings })
 }

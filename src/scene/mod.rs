@@ -9,6 +9,18 @@ mod mitsuba;
 pub use load::{SceneOverrides, load_scene, load_scene_str, load_texture};
 pub use mitsuba::{MitsubaExport, export_mitsuba};
 
+/// One mesh file's surface, by extension: OBJ (no tangents), or glTF 2.0 (.gltf, .glb: every
+/// triangle primitive in world space, with per-vertex tangents where every primitive has
+/// TANGENT). For `tessera deform`, which needs the surface and its UVs, not a scene.
+pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Option<Vec<Vec3>>)> {
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    match extension.as_deref() {
+        Some("gltf" | "glb") => gltf::import_surface(path),
+        Some("obj") => Ok((crate::geometry::obj::load_obj(path)?, None)),
+        _ => Err(crate::Error::mesh(path, "expected a mesh file ending in .obj, .gltf or .glb")),
+    }
+}
+
 use crate::accel::Accel;
 use crate::camera::PerspectiveCamera;
 use crate::geometry::{Bounds, Ray, SurfaceInteraction, TriangleMesh, TriangleVertices};

@@ -27,6 +27,60 @@ pub fn obj_text(mesh: &tessera::geometry::TriangleMesh) -> String {
     obj
 }
 
+/// `mesh` (with UVs) as a glTF file referring to `bin_name` for its data: positions, TEXCOORD_0
+/// (glTF's top-left origin: v' = 1 - v) and, if given, TANGENT (w = 1). Returns (json, bin).
+pub fn gltf_text(
+    mesh: &tessera::geometry::TriangleMesh,
+    tangents: Option<&[Vec3]>,
+    bin_name: &str,
+) -> (String, Vec<u8>) {
+    let uvs = mesh.uvs.as_ref().expect("a mesh with UVs");
+    let n = mesh.positions.len();
+    let mut bin = Vec::new();
+    let mut put = |values: &[f32]| values.iter().for_each(|v| bin.extend(v.to_le_bytes()));
+    mesh.positions.iter().for_each(|p| put(&p.to_array()));
+    uvs.iter().for_each(|t| put(&[t.x, 1.0 - t.y]));
+    if let Some(tangents) = tangents {
+        tangents.iter().for_each(|t| put(&[t.x, t.y, t.z, 1.0]));
+    }
+    let index_offset = bin.len();
+    mesh.indices.iter().flatten().for_each(|i| bin.extend(i.to_le_bytes()));
+    let (lo, hi) =
+        mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let tangent_attribute = if tangents.is_some() { r#", "TANGENT": 3"# } else { "" };
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}], "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1{tangent_attribute}}}, "indices": 2}}]}}],
+  "buffers": [{{"uri": "{bin_name}", "byteLength": {len}}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": {p}}},
+    {{"buffer": 0, "byteOffset": {p}, "byteLength": {t}}},
+    {{"buffer": 0, "byteOffset": {index_offset}, "byteLength": {i}}},
+    {{"buffer": 0, "byteOffset": {tan_offset}, "byteLength": {tan}}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": {n}, "type": "VEC3", "min": [{}, {}, {}], "max": [{}, {}, {}]}},
+    {{"bufferView": 1, "componentType": 5126, "count": {n}, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5125, "count": {count}, "type": "SCALAR"}},
+    {{"bufferView": 3, "componentType": 5126, "count": {n}, "type": "VEC4"}}
+  ]}}"#,
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z,
+        len = bin.len(),
+        p = n * 12,
+        t = n * 8,
+        i = mesh.indices.len() * 12,
+        count = mesh.indices.len() * 3,
+        tan_offset = n * 20,
+        tan = if tangents.is_some() { n * 16 } else { 4 },
+    );
+    (json, bin)
+}
+
 /// Write `toml` as `scene.toml` (and `files` beside it) in a fresh temporary folder.
 pub fn scene_dir(toml: &str, files: &[(&str, &[u8])]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().expect("temporary folder");
