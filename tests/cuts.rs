@@ -33,14 +33,7 @@ fn tube(width: f32, height: f32, angle: f32) -> TriangleMesh {
             uvs.push(Vec2::splat(0.5) + turn.rotate(flat));
         }
     }
-    for k in 0..segments {
-        for r in 0..rows {
-            let i = (k * (rows + 1) + r) as u32;
-            let j = i + rows as u32 + 1;
-            mesh.indices.push([i, j, i + 1]);
-            mesh.indices.push([i + 1, j, j + 1]);
-        }
-    }
+    mesh.indices = common::grid_triangles(segments, rows);
     mesh.uvs = Some(uvs);
     mesh
 }
@@ -154,15 +147,22 @@ fn eq8_makes_a_seam_within_one_cell_continuous_for_every_operator() {
 /// Tiles of 0.1: a cut 0.9 long is split into 4 cells.
 const SMALL_TILE: f32 = 0.1;
 
+/// The seam metric without and with Eq. 8 (linear blending, small tiles) on `mesh`, which must
+/// give `cells` boundary cells.
+fn seams_off_and_on(mesh: &TriangleMesh, cells: usize, what: &str) -> (f64, f64) {
+    let m = maps(mesh, SMALL_TILE);
+    assert_eq!(m.cuts.cells.len(), cells, "{:?}", m.cuts.cells);
+    let off = seams(&m, SMALL_TILE, Blend::Linear, false);
+    let on = seams(&m, SMALL_TILE, Blend::Linear, true);
+    eprintln!("{what}, {cells} cells: without Eq. 8 {off:.4}, with {on:.6}");
+    (off, on)
+}
+
 #[test]
 fn eq8_makes_a_lattice_aligned_seam_continuous_across_cells() {
     // The lat-long layout: the sides 1 apart (10 lattice spacings), so both sides see the same
     // paving weights, also where cells meet.
-    let m = maps(&tube(1.0, 0.9, 0.0), SMALL_TILE);
-    assert_eq!(m.cuts.cells.len(), 4, "{:?}", m.cuts.cells);
-    let off = seams(&m, SMALL_TILE, Blend::Linear, false);
-    let on = seams(&m, SMALL_TILE, Blend::Linear, true);
-    eprintln!("lattice-aligned seam, 4 cells: without Eq. 8 {off:.4}, with {on:.6}");
+    let (off, on) = seams_off_and_on(&tube(1.0, 0.9, 0.0), 4, "lattice-aligned seam");
     assert!(on < 0.01 && off > 0.4, "{on} {off}");
 }
 
@@ -171,11 +171,7 @@ fn eq8_lowers_seams_where_cells_meet() {
     // A turned chart: the sides are not a lattice vector apart, nor along a lattice row, so
     // where two cells meet the paving weighs their tiles differently on the two sides, a limit
     // of Sec. 5's method that the note reports.
-    let m = maps(&tube(0.6, 0.6, 0.3), SMALL_TILE);
-    assert_eq!(m.cuts.cells.len(), 2, "{:?}", m.cuts.cells);
-    let off = seams(&m, SMALL_TILE, Blend::Linear, false);
-    let on = seams(&m, SMALL_TILE, Blend::Linear, true);
-    eprintln!("unaligned seam, 4 cells: without Eq. 8 {off:.4}, with {on:.4}");
+    let (off, on) = seams_off_and_on(&tube(0.6, 0.6, 0.3), 2, "turned seam");
     assert!(on < 0.5 * off, "{on} {off}");
 }
 

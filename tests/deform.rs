@@ -30,14 +30,7 @@ fn cylinder_strip(scale: f32) -> TriangleMesh {
             uvs.push((Vec2::new(arc, h) + Vec2::splat(0.05)) * scale);
         }
     }
-    for k in 0..segments {
-        for r in 0..rows {
-            let i = (k * (rows + 1) + r) as u32;
-            let j = i + rows as u32 + 1;
-            mesh.indices.push([i, j, i + 1]);
-            mesh.indices.push([i + 1, j, j + 1]);
-        }
-    }
+    mesh.indices = common::grid_triangles(segments, rows);
     mesh.uvs = Some(uvs);
     mesh
 }

@@ -14,6 +14,21 @@ pub fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Two triangles per cell of a grid of `columns` x `rows` cells whose vertices are numbered
+/// column by column, `rows + 1` per column.
+pub fn grid_triangles(columns: usize, rows: usize) -> Vec<[u32; 3]> {
+    let mut indices = Vec::new();
+    for k in 0..columns {
+        for r in 0..rows {
+            let i = (k * (rows + 1) + r) as u32;
+            let j = i + rows as u32 + 1;
+            indices.push([i, j, i + 1]);
+            indices.push([i + 1, j, j + 1]);
+        }
+    }
+    indices
+}
+
 /// `mesh` (with UVs) as OBJ text.
 pub fn obj_text(mesh: &tessera::geometry::TriangleMesh) -> String {
     let uvs = mesh.uvs.as_ref().expect("a mesh with UVs");
