@@ -221,3 +221,47 @@ fn analyze_prints_the_seam_metric_with_and_without_eq8() {
     assert!(figure("; deformed ") > 0.4, "{stdout}");
     assert!(figure("deformed ") < 1.05 && figure("classical ") > 1.2, "distortion: {stdout}");
 }
+
+#[test]
+fn inset_keeps_the_tiles_of_a_cell_inside_the_exemplar() {
+    // tileable = false: a cell's tiles, which read the exemplar up to a cell away from their
+    // centre b_l, must stay inside its square wherever they weigh, on both sides of the cut,
+    // for every shift h_l (one per seed: the tube has one cell).
+    let m = maps(&tube(0.9, 0.4, 0.0), TILE);
+    assert_eq!(m.cuts.cells.len(), 1);
+    let cuts = CutMap::new(&m.cut_map).unwrap();
+    let mut cell_tiles = 0;
+    for seed in 0..64 {
+        let field = vec![
+            Deformation::Constant(glam::Mat2::from_diagonal(Vec2::splat(0.2))),
+            Deformation::Map(MipMap::new(m.f_map.clone())),
+        ];
+        let synthesis = Synthesis {
+            tiling: Tiling::Hexagonal,
+            tile_size: TILE,
+            seed,
+            deformation: Some(DeformationField::new(field)),
+            cuts: Some(cuts.clone()),
+            blend: Blend::Linear,
+            inset: true,
+        };
+        for i in 0..50 {
+            for j in 0..20 {
+                let uv = Vec2::new(i as f32 / 50.0, 0.3 + 0.4 * j as f32 / 20.0);
+                let tiles = Tiling::Hexagonal.tiles(uv, TILE);
+                let lookups = synthesis.lookups(&TexCtx { uv, ..Default::default() });
+                for (tile, lookup) in tiles.iter().zip(&lookups).take(3) {
+                    if lookup.weight > 0.0 && cuts.at(tile.centre).is_some() {
+                        cell_tiles += 1;
+                        let x = lookup.ctx.uv;
+                        assert!(
+                            x.cmpge(Vec2::ZERO).all() && x.cmple(Vec2::ONE).all(),
+                            "seed {seed} at {uv}: reads {x}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(cell_tiles > 10_000, "{cell_tiles}");
+}

@@ -11,6 +11,7 @@
 use super::nearest::{NONE, distance2_to_segment, propagate_nearest};
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
+use crate::math::largest_singular_value;
 use glam::{Mat2, Vec2};
 use std::collections::{HashMap, VecDeque};
 
@@ -249,11 +250,12 @@ impl Cuts {
     }
 
     /// The cut map over the UV square at `res` x `res` (row 0 at the top, v = 1, as image
-    /// textures are laid out; DESIGN.md section 6): each texel within `band` (UV units) of a
-    /// cut edge's copy takes the cell of the nearest copy: channels (l + 1, b.x, b.y, sigma)
-    /// with b that side's centre and sigma the largest singular value of `f` at the cell's two
-    /// centres (the scale of the cell's tiles in the exemplar, for shifts kept inside it);
-    /// texels outside every band hold 0.
+    /// textures are laid out; DESIGN.md section 6): each texel within `band` (UV units, at
+    /// least a tile's support radius) of a cut edge's copy takes the cell of the nearest copy:
+    /// channels (l + 1, b.x, b.y, reach) with b that side's centre and reach how far from b a
+    /// tile of the cell reads in the exemplar through the field `f`, on either side: the largest
+    /// sigma_max(F(c)) (|c - b| + `band`) over the cell's texels c, for shifts that keep the
+    /// tiles inside the exemplar. Texels outside every band hold 0.
     pub fn cut_map(&self, res: usize, band: f32, f: impl Fn(Vec2) -> Mat2) -> Bitmap {
         let point = |i: usize, j: usize| Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
         let segment = |id: u32| self.edges[id as usize / 2].sides[id as usize % 2];
@@ -282,21 +284,24 @@ impl Cuts {
             let [a, b] = segment(id);
             distance2_to_segment(point(i, j), a, b)
         });
-        let sigma: Vec<f32> = self
-            .cells
-            .iter()
-            .map(|c| c.centres.iter().map(|b| largest_singular_value(f(*b))).fold(0.0, f32::max))
-            .collect();
+        // Each band texel's cell and centre, then each cell's reach over its texels.
+        let in_band = |k: usize| {
+            (owner[k] != NONE && best[k] <= band * band).then(|| {
+                let cell = self.cell_of_edge[owner[k] as usize / 2] as usize;
+                (cell, self.cells[cell].centres[owner[k] as usize % 2])
+            })
+        };
+        let mut reach = vec![0.0f32; self.cells.len()];
+        for k in 0..res * res {
+            if let Some((cell, b)) = in_band(k) {
+                let c = point(k % res, k / res);
+                reach[cell] = reach[cell].max(largest_singular_value(f(c)) * (c.distance(b) + band));
+            }
+        }
         let mut map = Bitmap::new(res, res, 4);
-        for j in 0..res {
-            for i in 0..res {
-                let k = j * res + i;
-                if owner[k] == NONE || best[k] > band * band {
-                    continue;
-                }
-                let cell = self.cell_of_edge[owner[k] as usize / 2];
-                let b = self.cells[cell as usize].centres[owner[k] as usize % 2];
-                map.values_mut(i, res - 1 - j).copy_from_slice(&[(cell + 1) as f32, b.x, b.y, sigma[cell as usize]]);
+        for k in 0..res * res {
+            if let Some((cell, b)) = in_band(k) {
+                map.values_mut(k % res, res - 1 - k / res).copy_from_slice(&[(cell + 1) as f32, b.x, b.y, reach[cell]]);
             }
         }
         map
@@ -317,11 +322,4 @@ impl Cuts {
         }
         (total > 0.0).then(|| sum / total)
     }
-}
-
-/// The largest singular value of a 2x2 matrix.
-fn largest_singular_value(m: Mat2) -> f32 {
-    let frobenius2 = m.x_axis.length_squared() + m.y_axis.length_squared();
-    let det = m.determinant();
-    ((frobenius2 + (frobenius2 * frobenius2 - 4.0 * det * det).max(0.0).sqrt()) * 0.5).sqrt()
 }

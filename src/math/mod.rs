@@ -125,6 +125,13 @@ pub fn normal_quantile(p: f64) -> f64 {
     x - u / (1.0 + x * u / 2.0)
 }
 
+/// The largest singular value of a 2x2 matrix (its spectral norm).
+pub fn largest_singular_value(m: glam::Mat2) -> f32 {
+    let frobenius2 = m.x_axis.length_squared() + m.y_axis.length_squared();
+    let det = m.determinant();
+    ((frobenius2 + (frobenius2 * frobenius2 - 4.0 * det * det).max(0.0).sqrt()) * 0.5).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,5 +183,18 @@ mod tests {
             let x = i as f32 * 0.1;
             assert!((normal_cdf_f32(x) as f64 - normal_cdf(x as f64)).abs() < 2e-7, "{x}");
         }
+    }
+
+    #[test]
+    fn largest_singular_value_of_known_matrices() {
+        use glam::{Mat2, Vec2};
+        assert!((largest_singular_value(Mat2::from_diagonal(Vec2::new(3.0, -5.0))) - 5.0).abs() < 1e-5);
+        // A rotation times diag(2, 0.5): 2; a shear [[1, 1], [0, 1]]: the golden ratio.
+        assert!(
+            (largest_singular_value(Mat2::from_angle(0.7) * Mat2::from_diagonal(Vec2::new(2.0, 0.5))) - 2.0).abs()
+                < 1e-5
+        );
+        let shear = Mat2::from_cols(Vec2::X, Vec2::ONE);
+        assert!((largest_singular_value(shear) - 1.618_034).abs() < 1e-5);
     }
 }

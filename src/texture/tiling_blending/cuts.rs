@@ -12,12 +12,12 @@ pub struct CellTexel {
     pub cell: u32,
     /// This side's centre, b_l or b'_l, in UV.
     pub centre: Vec2,
-    /// The largest singular value of F at the cell's centres: how far a tile of the cell reaches
-    /// into the exemplar per UV unit, the same on both sides.
-    pub stretch: f32,
+    /// How far from its origin a tile of the cell reads in the exemplar through the F map, on
+    /// either side of the cut (for shifts that keep the cell's tiles inside the exemplar).
+    pub reach: f32,
 }
 
-/// A cut map: texels (l + 1, b.x, b.y, sigma), 0 outside every cell; row 0 at the top (v = 1).
+/// A cut map: texels (l + 1, b.x, b.y, reach), 0 outside every cell; row 0 at the top (v = 1).
 #[derive(Clone, Debug)]
 pub struct CutMap {
     width: usize,
@@ -29,7 +29,7 @@ impl CutMap {
     /// Read a four-channel cut map, checking that it holds what `tessera deform` writes.
     pub fn new(map: &Bitmap) -> Result<Self, String> {
         if map.channels != 4 {
-            return Err(format!("a cut map needs 4 channels (cell + 1, b.x, b.y, sigma), found {}", map.channels));
+            return Err(format!("a cut map needs 4 channels (cell + 1, b.x, b.y, reach), found {}", map.channels));
         }
         let texels = map
             .data
@@ -45,9 +45,9 @@ impl CutMap {
                     return Err(format!("the cut map's first channel holds {}, not a cell number (0 or l + 1)", t[0]));
                 }
                 if !(t[3] > 0.0) {
-                    return Err(format!("the cut map gives cell {} a stretch of {}", t[0] - 1.0, t[3]));
+                    return Err(format!("the cut map gives cell {} a reach of {}", t[0] - 1.0, t[3]));
                 }
-                Ok(Some(CellTexel { cell: t[0] as u32 - 1, centre: Vec2::new(t[1], t[2]), stretch: t[3] }))
+                Ok(Some(CellTexel { cell: t[0] as u32 - 1, centre: Vec2::new(t[1], t[2]), reach: t[3] }))
             })
             .collect::<Result<_, _>>()?;
         Ok(CutMap { width: map.width, height: map.height, texels })

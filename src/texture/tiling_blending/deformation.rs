@@ -85,6 +85,16 @@ impl DeformationField {
         }
     }
 
+    /// The product of the largest singular values of the factors other than F maps at `uv`: how
+    /// much they can stretch what a map gives (1 without such factors).
+    pub fn stretch_besides_maps(&self, uv: Vec2) -> f32 {
+        self.factors
+            .iter()
+            .filter(|f| !matches!(f, Deformation::Map(_)))
+            .map(|f| crate::math::largest_singular_value(f.at(uv)))
+            .product()
+    }
+
     /// Bytes held by F maps.
     pub fn memory_bytes(&self) -> usize {
         self.factors.iter().map(|f| if let Deformation::Map(m) = f { m.memory_bytes() } else { 0 }).sum()

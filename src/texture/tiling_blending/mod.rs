@@ -167,10 +167,7 @@ impl Synthesis {
             let (centre, h) = match cells[i] {
                 Some(cell) => {
                     let h = cell_shift(cell.cell, self.seed);
-                    (
-                        cell.centre,
-                        if self.inset { inset_shift(h, Vec2::splat(self.cell_reach(cell.stretch))) } else { h },
-                    )
+                    (cell.centre, if self.inset { inset_shift(h, Vec2::splat(self.cell_reach(&cell))) } else { h })
                 }
                 None => {
                     let h = shift(tile.vertex, self.seed);
@@ -201,12 +198,12 @@ impl Synthesis {
         self.tiling.support_corners().iter().fold(Vec2::ZERO, |r, corner| r.max((f * (*corner * self.tile_size)).abs()))
     }
 
-    /// How far a tile of a boundary cell reaches into the exemplar along any axis: its support's
-    /// radius times the cell's largest stretch (the same on both sides of the cut, whose UV
-    /// axes differ).
-    fn cell_reach(&self, stretch: f32) -> f32 {
-        let radius = self.tiling.support_corners().iter().map(|c| c.length()).fold(0.0, f32::max);
-        stretch * radius * self.tile_size
+    /// How far a tile of a boundary cell reaches into the exemplar along any axis, the same on
+    /// both sides of the cut (whose UV axes differ): the cut map's reach through the F map,
+    /// times the largest singular values of the field's other factors at this side's centre
+    /// (exactly the same on both sides for constant factors).
+    fn cell_reach(&self, cell: &CellTexel) -> f32 {
+        cell.reach * self.deformation.as_ref().map_or(1.0, |d| d.stretch_besides_maps(cell.centre))
     }
 
     /// The blending weights of the tiles: the paving's for the linear and variance-preserving
