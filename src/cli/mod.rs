@@ -122,7 +122,7 @@ enum Command {
     },
     /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and its UV cuts'
     /// boundary cells (Sec. 5): writes f_map.exr (F00, F01, F10, F11), cut_map.exr (cell + 1,
-    /// b.x, b.y, sigma) and pictures of |det F|, the orientation and the cells.
+    /// b.x, b.y, reach) and pictures of |det F|, the orientation and the cells.
     Deform {
         #[command(flatten)]
         mesh: deform::MeshArgs,
