@@ -219,7 +219,9 @@ impl Cuts {
                 cell_of[e as usize] = target as u32;
             }
             members[target].extend(moved);
-            lengths[target] = [lengths[target][0] + lengths[cell][0], lengths[target][1] + lengths[cell][1]];
+            let [left, right] = lengths[cell];
+            let added = if swapped { [right, left] } else { [left, right] };
+            lengths[target] = [lengths[target][0] + added[0], lengths[target][1] + added[1]];
         }
         // Compact the ids and keep each cell's most central edge.
         let mut renumber = vec![NONE; members.len()];
