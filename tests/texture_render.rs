@@ -158,19 +158,5 @@ fn filtered_lookups_converge_to_unfiltered_render() {
         let (_dir, scene) = scene(&toml, &[("t.png", &png)]);
         render(&scene, None, &[], &|_, _| {}).radiance()
     };
-    let rmse = |a: &Bitmap, b: &Bitmap| {
-        (a.data.iter().zip(&b.data).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>() / a.data.len() as f64).sqrt()
-    };
-    let mean = |a: &Bitmap| a.data.iter().map(|&x| x as f64).sum::<f64>() / a.data.len() as f64;
-    let reference = render_with("none", 2048);
-    let unfiltered = render_with("none", 8);
-    let e_unfiltered = rmse(&unfiltered, &reference);
-    for filter in ["trilinear", "ewa"] {
-        let low = render_with(filter, 8);
-        let high = render_with(filter, 1024);
-        let (e_low, e_high) = (rmse(&low, &reference), rmse(&high, &reference));
-        assert!(e_low < 0.8 * e_unfiltered, "{filter}: rmse {e_low} at 8 spp vs unfiltered {e_unfiltered}");
-        assert!(e_high < 0.3 * e_low, "{filter}: rmse {e_high} at 1024 spp does not approach the reference");
-        assert!((mean(&low) - mean(&reference)).abs() < 0.01 * mean(&reference), "{filter}: mean drifts");
-    }
+    common::assert_filtered_renders_converge(render_with);
 }
