@@ -42,17 +42,21 @@ fn maps(mesh: &TriangleMesh, tile: f32) -> DeformationMaps {
     deformation_maps(mesh, &Orientation::Parallels(Vec3::Y), 32, 512, tile).unwrap()
 }
 
-fn bark() -> (Arc<Texture>, Vec3) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textures/bark.jpg");
-    let bitmap = read_bitmap(&path, ColorSpace::Srgb).unwrap();
-    let spread = channel_std(&bitmap);
-    let texture = ImageTexture {
-        mipmap: Arc::new(MipMap::new(bitmap)),
-        filter: Filter::None,
-        scale: Vec2::ONE,
-        offset: Vec2::ZERO,
-    };
-    (Arc::new(Texture::Image(texture)), spread)
+/// The bark exemplar (point lookups) and its channels' standard deviations, read once.
+fn bark() -> &'static (Arc<Texture>, Vec3) {
+    static BARK: std::sync::OnceLock<(Arc<Texture>, Vec3)> = std::sync::OnceLock::new();
+    BARK.get_or_init(|| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textures/bark.jpg");
+        let bitmap = read_bitmap(&path, ColorSpace::Srgb).unwrap();
+        let spread = channel_std(&bitmap);
+        let texture = ImageTexture {
+            mipmap: Arc::new(MipMap::new(bitmap)),
+            filter: Filter::None,
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        };
+        (Arc::new(Texture::Image(texture)), spread)
+    })
 }
 
 /// Deformed T&B with the maps' F, with or without Eq. 8.
@@ -66,7 +70,7 @@ fn texture(maps: &DeformationMaps, tile: f32, blend: Blend, eq8: bool) -> Tiling
         blend,
         inset: false,
     };
-    TilingBlending::new(Arc::new(synthesis), bark().0).unwrap()
+    TilingBlending::new(Arc::new(synthesis), bark().0.clone()).unwrap()
 }
 
 fn seams(maps: &DeformationMaps, tile: f32, blend: Blend, eq8: bool) -> f64 {

@@ -117,9 +117,8 @@ fn f_map_field(maps: &DeformationMaps) -> DeformationField {
     DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))])
 }
 
-/// Print the distortion metric, classical against deformed.
-fn print_distortion(mesh: &TriangleMesh, maps: &DeformationMaps) {
-    let field = f_map_field(maps);
+/// Print the distortion metric, classical against deformed through `field`.
+fn print_distortion(mesh: &TriangleMesh, field: &DeformationField) {
     let classical = distortion(mesh, |_| Mat2::IDENTITY);
     let deformed = distortion(mesh, |uv| field.at(uv));
     if let (Some(c), Some(d)) = (classical, deformed) {
@@ -146,7 +145,7 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     write_image(&output.join("det_f.png"), &det, &[])?;
     write_image(&output.join("orientation.png"), &orientation_picture, &[])?;
     write_image(&output.join("cells.png"), &tessera::deform::cut_map_picture(&maps.cut_map), &[])?;
-    print_distortion(&mesh, &maps);
+    print_distortion(&mesh, &f_map_field(&maps));
     let res = args.res;
     eprintln!(
         "{}: {} triangles ({} mirrored in UV), grid {g}x{g} ({} samples outside every triangle, filled from the nearest), \
@@ -189,7 +188,8 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize)
         };
         TilingBlending::new(Arc::new(synthesis), exemplar.clone()).map_err(|msg| Error::image(exemplar_path, msg))
     };
-    print_distortion(&mesh, &maps);
+    let field = f_map_field(&maps);
+    print_distortion(&mesh, &field);
     if maps.cuts.edges.is_empty() {
         println!("seams: the mesh has no UV cuts");
         return Ok(ExitCode::SUCCESS);
@@ -197,8 +197,8 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize)
     let seams = |texture: TilingBlending| seam_metric(&maps.cuts, &texture, spread, samples).unwrap_or(f64::NAN);
     let classical = seams(texture(None, None)?);
     let classical_cells = seams(texture(None, Some(cut_map.clone()))?);
-    let deformed = seams(texture(Some(f_map_field(&maps)), None)?);
-    let deformed_cells = seams(texture(Some(f_map_field(&maps)), Some(cut_map))?);
+    let deformed = seams(texture(Some(field.clone()), None)?);
+    let deformed_cells = seams(texture(Some(field), Some(cut_map))?);
     println!(
         "seams over {} cut edges in {} boundary cells (mean |T_left - T_right| / std(exemplar), hexagonal tiles of {}, \
          linear blending): classical {classical:.4}, classical with Eq. 8 {classical_cells:.4}; deformed {deformed:.4}, \

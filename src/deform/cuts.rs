@@ -251,14 +251,20 @@ impl Cuts {
         self.cell_of_edge = cell_of.iter().map(|&c| renumber[c as usize]).collect();
     }
 
-    /// The cut map over the UV square at `res` x `res` (row 0 at the top, v = 1, as image
-    /// textures are laid out; DESIGN.md section 6): each texel within `band` (UV units, at
-    /// least a tile's support radius) of a cut edge's copy takes the cell of the nearest copy:
-    /// channels (l + 1, b.x, b.y, reach) with b that side's centre and reach how far from b a
-    /// tile of the cell reads in the exemplar through the field `f`, on either side: the largest
-    /// sigma_max(F(c)) (|c - b| + `band`) over the cell's texels c, for shifts that keep the
-    /// tiles inside the exemplar. Texels outside every band hold 0.
-    pub fn cut_map(&self, res: usize, band: f32, f: impl Fn(Vec2) -> Mat2) -> Bitmap {
+    /// The cut map over the UV square at the resolution of the square `f_map` it goes with
+    /// (row 0 at the top, v = 1, as image textures are laid out; DESIGN.md section 6): each
+    /// texel within `band` (UV units, at least a tile's support radius) of a cut edge's copy
+    /// takes the cell of the nearest copy: channels (l + 1, b.x, b.y, reach) with b that side's
+    /// centre and reach how far from b a tile of the cell reads in the exemplar through the F
+    /// map, on either side: the largest sigma_max(F(c)) (|c - b| + `band`) over the cell's
+    /// texels c, for shifts that keep the tiles inside the exemplar. Texels outside every band
+    /// hold 0.
+    pub fn cut_map(&self, f_map: &Bitmap, band: f32) -> Bitmap {
+        let res = f_map.width;
+        let f_at = |i: usize, j: usize| {
+            let f = f_map.values(i, res - 1 - j);
+            Mat2::from_cols(Vec2::new(f[0], f[2]), Vec2::new(f[1], f[3]))
+        };
         let point = |i: usize, j: usize| Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
         let segment = |id: u32| self.edges[id as usize / 2].sides[id as usize % 2];
         let mut owner = vec![NONE; res * res];
@@ -296,8 +302,8 @@ impl Cuts {
         let mut reach = vec![0.0f32; self.cells.len()];
         for k in 0..res * res {
             if let Some((cell, b)) = in_band(k) {
-                let c = point(k % res, k / res);
-                reach[cell] = reach[cell].max(largest_singular_value(f(c)) * (c.distance(b) + band));
+                let (i, j) = (k % res, k / res);
+                reach[cell] = reach[cell].max(largest_singular_value(f_at(i, j)) * (point(i, j).distance(b) + band));
             }
         }
         let mut map = Bitmap::new(res, res, 4);

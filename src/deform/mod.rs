@@ -150,7 +150,7 @@ pub fn deformation_maps(
         }
     }
     let cuts = Cuts::new(mesh, 2.0 * tile_size);
-    let cut_map = cuts.cut_map(res, std::f32::consts::SQRT_2 * tile_size, |uv| grid.at(uv));
+    let cut_map = cuts.cut_map(&f_map, std::f32::consts::SQRT_2 * tile_size);
     Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored })
 }
 

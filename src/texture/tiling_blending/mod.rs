@@ -166,6 +166,11 @@ impl Synthesis {
             cells[i] = self.cuts.as_ref().and_then(|c| c.at(tile.centre));
             let (centre, h) = match cells[i] {
                 Some(cell) => {
+                    if let Some(first) = (0..i).find(|&j| cells[j] == Some(cell)) {
+                        out[first].weight += tile.weight;
+                        out[i] = TileLookup { weight: 0.0, ..out[first] };
+                        continue;
+                    }
                     let h = cell_shift(cell.cell, self.seed);
                     (cell.centre, if self.inset { inset_shift(h, Vec2::splat(self.cell_reach(&cell))) } else { h })
                 }
@@ -174,13 +179,6 @@ impl Synthesis {
                     (tile.centre, if self.inset { inset_shift(h, self.tile_reach(tile.centre)) } else { h })
                 }
             };
-            if let Some(cell) = cells[i] {
-                if let Some(first) = (0..i).find(|&j| cells[j] == Some(cell)) {
-                    out[first].weight += tile.weight;
-                    out[i] = TileLookup { weight: 0.0, ..out[first] };
-                    continue;
-                }
-            }
             let offset = ctx.uv - centre;
             out[i].weight = tile.weight;
             out[i].ctx = match f {
