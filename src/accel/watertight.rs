@@ -1,19 +1,50 @@
 //! Watertight ray-triangle intersection (Woop, Benthin, Wald 2013, "Watertight Ray/Triangle
-//! Intersection", JCGT 2(1)).
+//! Intersection", JCGT 2(1)), four triangles at a time.
 //!
 //! The paper permutes the axes so that the ray direction's largest component is z, then shears
-//! the ray onto +z. Both steps are linear, so they are folded here into one per-ray 3x3 matrix
-//! applied to each vertex (relative to the ray origin): the same arithmetic, without branching
-//! on the permutation per triangle.
+//! the ray onto +z. The permutation is per ray, so it only chooses which coordinate arrays of a
+//! [`TrianglePacket`] are read; the shear is three multiply-adds per vertex, on four triangles
+//! at once (SSE2 or NEON lanes through glam's `Vec4`).
 
 use crate::geometry::Ray;
-use glam::{Mat3A, Vec3, Vec3A};
+use glam::{BVec4A, Vec3, Vec4};
 
-/// Per-ray constants: the origin and the permute-and-shear transform.
+/// Four triangles in structure-of-arrays form: `v[k][axis]` holds coordinate `axis` of vertex
+/// `k` of the four triangles, one per lane. Packets with fewer triangles repeat their first.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TrianglePacket {
+    v: [[Vec4; 3]; 3],
+}
+
+impl TrianglePacket {
+    /// Pack one to four triangles.
+    pub(super) fn new(triangles: &[[Vec3; 3]]) -> Self {
+        assert!((1..=4).contains(&triangles.len()), "a packet holds 1 to 4 triangles");
+        let lane = |i: usize| triangles.get(i).unwrap_or(&triangles[0]);
+        let v = std::array::from_fn(|k| {
+            std::array::from_fn(|axis| Vec4::from_array(std::array::from_fn(|i| lane(i)[k][axis])))
+        });
+        TrianglePacket { v }
+    }
+}
+
+/// A hit on one lane of a packet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct PacketHit {
+    pub lane: usize,
+    pub t: f32,
+    pub b1: f32,
+    pub b2: f32,
+}
+
+/// Per-ray constants of the test: the axis permutation, and the origin and shear in permuted
+/// axes, splatted over the four lanes.
 pub(super) struct RayShear {
-    origin: Vec3A,
-    /// Rows: (e_kx - Sx e_kz), (e_ky - Sy e_kz), Sz e_kz.
-    shear: Mat3A,
+    /// Indices of the permuted x, y, z axes (z: the direction's largest component).
+    k: [usize; 3],
+    origin: [Vec4; 3],
+    /// (Sx, Sy, Sz) of the paper.
+    shear: [Vec4; 3],
 }
 
 impl RayShear {
@@ -34,41 +65,73 @@ impl RayShear {
             std::mem::swap(&mut kx, &mut ky);
         }
         let sz = 1.0 / d[kz];
-        let (sx, sy) = (d[kx] * sz, d[ky] * sz);
-        let e = |k: usize| Vec3A::from(Vec3::AXES[k]);
-        let rows = [e(kx) - e(kz) * sx, e(ky) - e(kz) * sy, e(kz) * sz];
-        RayShear { origin: Vec3A::from(ray.o), shear: Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose() }
+        let k = [kx, ky, kz];
+        RayShear {
+            k,
+            origin: k.map(|axis| Vec4::splat(ray.o[axis])),
+            shear: [d[kx] * sz, d[ky] * sz, sz].map(Vec4::splat),
+        }
     }
 
-    /// `(t, b1, b2)` of the hit with `0 < t < t_max`, or None.
+    /// The closest hit with `0 < t < t_max` among the packet's triangles, or None. Ties go to
+    /// the lowest lane.
     #[inline(always)]
-    pub(super) fn intersect(&self, tri: &[Vec3A; 3], t_max: f32) -> Option<(f32, f32, f32)> {
-        let a = self.shear * (tri[0] - self.origin);
-        let b = self.shear * (tri[1] - self.origin);
-        let c = self.shear * (tri[2] - self.origin);
+    pub(super) fn intersect(&self, packet: &TrianglePacket, t_max: f32) -> Option<PacketHit> {
+        let [kx, ky, kz] = self.k;
+        let [sx, sy, sz] = self.shear;
+        // Vertices relative to the origin, permuted and sheared: the ray is now the +z axis.
+        let sheared = |p: &[Vec4; 3]| {
+            let z = p[kz] - self.origin[2];
+            let x = (p[kx] - self.origin[0]) - sx * z;
+            let y = (p[ky] - self.origin[1]) - sy * z;
+            (x, y, sz * z)
+        };
+        let (ax, ay, az) = sheared(&packet.v[0]);
+        let (bx, by, bz) = sheared(&packet.v[1]);
+        let (cx, cy, cz) = sheared(&packet.v[2]);
         // Scaled barycentrics: signed areas of the sheared triangle seen from the ray.
-        let mut u = c.x * b.y - c.y * b.x;
-        let mut v = a.x * c.y - a.y * c.x;
-        let mut w = b.x * a.y - b.y * a.x;
-        // On an edge, recompute in double precision so that neighbours agree (paper, sec. 3).
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            u = (c.x as f64 * b.y as f64 - c.y as f64 * b.x as f64) as f32;
-            v = (a.x as f64 * c.y as f64 - a.y as f64 * c.x as f64) as f32;
-            w = (b.x as f64 * a.y as f64 - b.y as f64 * a.x as f64) as f32;
+        let mut u = cx * by - cy * bx;
+        let mut v = ax * cy - ay * cx;
+        let mut w = bx * ay - by * ax;
+        let zero = Vec4::ZERO;
+        let on_edge = u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero);
+        if on_edge.any() {
+            // On an edge, recompute in double precision so that neighbours agree (paper, sec. 3).
+            let (mut ua, mut va, mut wa) = (u.to_array(), v.to_array(), w.to_array());
+            let f = |x: Vec4, lane: usize| x.to_array()[lane] as f64;
+            for lane in (0..4).filter(|&lane| on_edge.test(lane)) {
+                let (ax, ay, bx, by, cx, cy) =
+                    (f(ax, lane), f(ay, lane), f(bx, lane), f(by, lane), f(cx, lane), f(cy, lane));
+                ua[lane] = (cx * by - cy * bx) as f32;
+                va[lane] = (ax * cy - ay * cx) as f32;
+                wa[lane] = (bx * ay - by * ax) as f32;
+            }
+            (u, v, w) = (Vec4::from_array(ua), Vec4::from_array(va), Vec4::from_array(wa));
         }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return None;
-        }
+        let negative = u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero);
+        let positive = u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero);
         let det = u + v + w;
-        if det == 0.0 || !det.is_finite() {
+        let t = (u * az + v * bz + w * cz) / det;
+        // A zero, infinite or NaN determinant gives a t that fails these comparisons.
+        let valid = !(negative & positive) & det.cmpne(zero) & t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
+        if !valid.any() {
             return None;
         }
-        let t_scaled = u * a.z + v * b.z + w * c.z;
-        let inv_det = 1.0 / det;
-        let t = t_scaled * inv_det;
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
-        Some((t, v * inv_det, w * inv_det))
+        let lane = closest_lane(valid, t);
+        let det = det.to_array()[lane];
+        Some(PacketHit { lane, t: t.to_array()[lane], b1: v.to_array()[lane] / det, b2: w.to_array()[lane] / det })
     }
+}
+
+/// The lane of the smallest `t` among `valid` lanes (one at least), the lowest on ties.
+#[inline(always)]
+fn closest_lane(valid: BVec4A, t: Vec4) -> usize {
+    let t = Vec4::select(valid, t, Vec4::INFINITY).to_array();
+    let mut best = valid.bitmask().trailing_zeros() as usize;
+    for lane in best + 1..4 {
+        if t[lane] < t[best] {
+            best = lane;
+        }
+    }
+    best
 }
