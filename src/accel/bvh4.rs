@@ -19,9 +19,6 @@ use obvhs::bvh2::Bvh2;
 
 /// Children of a node that are leaves: `LEAF | index into Bvh4::leaves`.
 const LEAF: u32 = 1 << 31;
-/// Entries of the traversal stack kept on the call stack; deeper stacks spill to the heap
-/// (each level of a BVH pushes at most three: 32 entries cover any tree of depth 10).
-const INLINE_STACK: usize = 32;
 /// 1 + 2 gamma(3) with gamma(n) = n eps / (1 - n eps), eps = 2^-24 (Ize 2013).
 const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
@@ -54,9 +51,8 @@ pub(super) struct Bvh4 {
 
 /// Per-ray constants of the box test.
 struct RayBoxes {
-    /// Index into `Node::bounds` of the near and far planes per axis.
-    near: [usize; 3],
-    far: [usize; 3],
+    /// Per axis, 1 when the near plane is the max plane (a negative direction), else 0.
+    near_is_max: [usize; 3],
     inv_d: [Vec4; 3],
     /// origin / direction, per axis.
     o_inv_d: [Vec4; 3],
@@ -68,10 +64,8 @@ impl RayBoxes {
         // so that no 0 * inf makes a NaN in the slab test.
         let inv = |d: f32| 1.0 / if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d };
         let inv_d = [inv(ray.d.x), inv(ray.d.y), inv(ray.d.z)];
-        let near: [usize; 3] = std::array::from_fn(|a| 2 * a + usize::from(inv_d[a] < 0.0));
         RayBoxes {
-            near,
-            far: near.map(|n| n ^ 1),
+            near_is_max: inv_d.map(|i| usize::from(i < 0.0)),
             inv_d: inv_d.map(Vec4::splat),
             o_inv_d: std::array::from_fn(|a| Vec4::splat(ray.o[a] * inv_d[a])),
         }
@@ -80,9 +74,14 @@ impl RayBoxes {
     /// Bit i set when the ray meets child i's box within (0, t_max); the entry distances.
     #[inline(always)]
     fn test(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
-        let slab = |plane: usize, axis: usize| node.bounds[plane] * self.inv_d[axis] - self.o_inv_d[axis];
-        let t_near = slab(self.near[0], 0).max(slab(self.near[1], 1)).max(slab(self.near[2], 2).max(Vec4::ZERO));
-        let t_far = slab(self.far[0], 0).min(slab(self.far[1], 1)).min(slab(self.far[2], 2).min(Vec4::splat(t_max)));
+        // Distance to the near (far: `max_side` 1) plane along `axis`; `& 1` keeps the index
+        // provably in bounds.
+        let slab = |axis: usize, max_side: usize| {
+            node.bounds[2 * axis + (max_side & 1)] * self.inv_d[axis] - self.o_inv_d[axis]
+        };
+        let [nx, ny, nz] = self.near_is_max;
+        let t_near = slab(0, nx).max(slab(1, ny)).max(slab(2, nz).max(Vec4::ZERO));
+        let t_far = slab(0, nx ^ 1).min(slab(1, ny ^ 1)).min(slab(2, nz ^ 1).min(Vec4::splat(t_max)));
         (t_near.cmple(t_far * ROBUST_FAR).bitmask(), t_near)
     }
 }
@@ -150,96 +149,67 @@ impl Bvh4 {
     fn traverse<const CLOSEST: bool>(&self, ray: &Ray, mut leaf: impl FnMut(std::ops::Range<usize>, &mut f32) -> bool) {
         let boxes = RayBoxes::new(ray);
         let mut t_max = ray.t_max;
-        let mut stack = TraversalStack::new();
-        let mut current = 0u32;
-        loop {
-            if current & LEAF == 0 {
-                let node = &self.nodes[current as usize];
-                let (mut mask, t_near) = boxes.test(node, t_max);
-                if mask != 0 {
-                    let t_near = t_near.to_array();
-                    if mask & (mask - 1) == 0 {
-                        current = node.children[mask.trailing_zeros() as usize];
-                        continue;
-                    }
-                    // Two to four children: push all but the nearest, farthest first.
-                    let mut hits = [(0u32, 0.0f32); 4];
-                    let mut n = 0;
-                    while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        hits[n] = (node.children[i], t_near[i]);
-                        n += 1;
-                    }
-                    if CLOSEST {
-                        // Insertion sort, farthest first; stable, so that ties keep child order.
-                        for i in 1..n {
-                            let mut j = i;
-                            while j > 0 && hits[j - 1].1 < hits[j].1 {
-                                hits.swap(j - 1, j);
-                                j -= 1;
+        TRAVERSAL_STACK.with_borrow_mut(|stack| {
+            stack.clear();
+            let mut current = 0u32;
+            loop {
+                if current & LEAF == 0 {
+                    let node = &self.nodes[current as usize];
+                    let (mut mask, t_near) = boxes.test(node, t_max);
+                    if mask != 0 {
+                        let t_near = t_near.to_array();
+                        if mask & (mask - 1) == 0 {
+                            current = node.children[mask.trailing_zeros() as usize];
+                            continue;
+                        }
+                        // Two to four children: push all but the nearest, farthest first.
+                        let mut hits = [(0u32, 0.0f32); 4];
+                        let mut n = 0;
+                        while mask != 0 {
+                            let i = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            hits[n] = (node.children[i], t_near[i]);
+                            n += 1;
+                        }
+                        if CLOSEST {
+                            // Insertion sort, farthest first; stable, so that ties keep child order.
+                            for i in 1..n {
+                                let mut j = i;
+                                while j > 0 && hits[j - 1].1 < hits[j].1 {
+                                    hits.swap(j - 1, j);
+                                    j -= 1;
+                                }
                             }
                         }
+                        stack.extend_from_slice(&hits[..n - 1]);
+                        current = hits[n - 1].0;
+                        continue;
                     }
-                    for &entry in &hits[..n - 1] {
-                        stack.push(entry);
+                } else {
+                    let Leaf { first, count } = self.leaves[(current & !LEAF) as usize];
+                    if leaf(first as usize..(first + count) as usize, &mut t_max) && !CLOSEST {
+                        return;
                     }
-                    current = hits[n - 1].0;
-                    continue;
                 }
-            } else {
-                let Leaf { first, count } = self.leaves[(current & !LEAF) as usize];
-                if leaf(first as usize..(first + count) as usize, &mut t_max) && !CLOSEST {
-                    return;
+                // Next: the nearest entry on the stack that is not beyond the closest hit.
+                loop {
+                    let Some((next, t_near)) = stack.pop() else {
+                        return;
+                    };
+                    if !CLOSEST || t_near <= t_max {
+                        current = next;
+                        break;
+                    }
                 }
             }
-            // Next: the nearest entry on the stack that is not beyond the closest hit.
-            loop {
-                let Some((next, t_near)) = stack.pop() else {
-                    return;
-                };
-                if !CLOSEST || t_near <= t_max {
-                    current = next;
-                    break;
-                }
-            }
-        }
+        })
     }
 }
 
-/// The traversal's stack of (child, entry distance): a small array, spilling to the heap only
-/// when a ray goes deeper than it holds (an allocation-free `Vec::new` until then).
-struct TraversalStack {
-    inline: [(u32, f32); INLINE_STACK],
-    len: usize,
-    spilled: Vec<(u32, f32)>,
-}
-
-impl TraversalStack {
-    #[inline(always)]
-    fn new() -> Self {
-        TraversalStack { inline: [(0, 0.0); INLINE_STACK], len: 0, spilled: Vec::new() }
-    }
-
-    #[inline(always)]
-    fn push(&mut self, entry: (u32, f32)) {
-        if self.len < INLINE_STACK {
-            self.inline[self.len] = entry;
-            self.len += 1;
-        } else {
-            self.spilled.push(entry);
-        }
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
-        // Spilled entries are the newest.
-        if let Some(entry) = self.spilled.pop() {
-            return Some(entry);
-        }
-        self.len = self.len.checked_sub(1)?;
-        Some(self.inline[self.len])
-    }
+thread_local! {
+    /// Each thread's traversal stack of (child, entry distance), reused by every query so that
+    /// none allocates or initialises one (queries do not nest: `leaf` never starts another).
+    static TRAVERSAL_STACK: std::cell::RefCell<Vec<(u32, f32)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Triangles under each node of a binary BVH.
@@ -347,20 +317,6 @@ impl Builder<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn traversal_stack_spills_to_the_heap_and_pops_in_order() {
-        let mut stack = TraversalStack::new();
-        let n = 3 * INLINE_STACK + 5;
-        for i in 0..n {
-            stack.push((i as u32, i as f32));
-        }
-        assert_eq!(stack.spilled.len(), n - INLINE_STACK);
-        for i in (0..n).rev() {
-            assert_eq!(stack.pop(), Some((i as u32, i as f32)));
-        }
-        assert_eq!(stack.pop(), None);
-    }
 
     #[test]
     fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
