@@ -321,7 +321,7 @@ mod tests {
     #[test]
     fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
         let tris = crate::accel::tests::lopsided_scene();
-        let bvh = crate::accel::Accel::build(&tris).bvh.expect("triangles");
+        let bvh = crate::accel::build_bvh4(&tris);
 
         // Walk the tree: every triangle is reached exactly once, inside every box above it.
         let mut seen = vec![0u32; tris.len()];

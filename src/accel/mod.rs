@@ -5,8 +5,11 @@
 //! measured faster than obvhs's own CWBVH and BVH2 traversals for the incoherent rays of path
 //! tracing (DESIGN.md section 2). Triangles are tested with the watertight algorithm of Woop,
 //! Benthin and Wald (2013), so that no ray slips between two triangles that share an edge.
+//! With the feature `embree`, Embree 3 is available too, and is the default backend.
 
 mod bvh4;
+#[cfg(feature = "embree")]
+mod embree;
 mod watertight;
 
 use crate::geometry::Ray;
@@ -27,25 +30,67 @@ pub struct Hit {
     pub b2: f32,
 }
 
+/// The ray-query implementations an [`Accel`] can be built with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AccelKind {
+    /// tessera's four-wide BVH over obvhs's build (`bvh4.rs`).
+    Bvh4,
+    /// Embree 3 (feature `embree`).
+    #[cfg(feature = "embree")]
+    Embree,
+}
+
+impl AccelKind {
+    /// Every kind this build has.
+    pub const ALL: &[AccelKind] = &[
+        AccelKind::Bvh4,
+        #[cfg(feature = "embree")]
+        AccelKind::Embree,
+    ];
+    /// The kind [`Accel::build`] uses: Embree where compiled in.
+    pub const DEFAULT: AccelKind = *Self::ALL.last().expect("one kind at least");
+}
+
+enum Backend {
+    /// No triangles.
+    Empty,
+    Bvh4(Bvh4),
+    #[cfg(feature = "embree")]
+    Embree(embree::EmbreeScene),
+}
+
 /// Bounding volume hierarchy over a fixed set of triangles.
 pub struct Accel {
-    /// None when there are no triangles.
-    bvh: Option<Bvh4>,
+    backend: Backend,
     triangle_count: usize,
 }
 
 impl Accel {
-    /// Build over `triangles`. Triangles of zero area are allowed: they are never hit.
+    /// Build the default kind over `triangles`. Triangles of zero area are allowed: they are
+    /// never hit.
     pub fn build(triangles: &[[Vec3; 3]]) -> Self {
-        if triangles.is_empty() {
-            return Accel { bvh: None, triangle_count: 0 };
-        }
-        let prims: Vec<Triangle> =
-            triangles.iter().map(|t| Triangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
-        // Leaves of up to four triangles: one packet.
-        let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::medium_build() };
-        let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(&prims, params, &mut std::time::Duration::default());
-        Accel { bvh: Some(Bvh4::from_bvh2(&bvh2, triangles)), triangle_count: triangles.len() }
+        Self::build_kind(triangles, AccelKind::DEFAULT)
+    }
+
+    /// Build `kind` over `triangles`. Where Embree fails to build (an unsupported CPU), this
+    /// says so and builds the four-wide BVH instead.
+    pub fn build_kind(triangles: &[[Vec3; 3]], kind: AccelKind) -> Self {
+        let backend = if triangles.is_empty() {
+            Backend::Empty
+        } else {
+            match kind {
+                AccelKind::Bvh4 => Backend::Bvh4(build_bvh4(triangles)),
+                #[cfg(feature = "embree")]
+                AccelKind::Embree => match embree::EmbreeScene::build(triangles) {
+                    Ok(scene) => Backend::Embree(scene),
+                    Err(e) => {
+                        eprintln!("warning: {e}; using tessera's own BVH");
+                        Backend::Bvh4(build_bvh4(triangles))
+                    }
+                },
+            }
+        };
+        Accel { backend, triangle_count: triangles.len() }
     }
 
     /// Number of triangles.
@@ -53,20 +98,44 @@ impl Accel {
         self.triangle_count
     }
 
-    /// Approximate memory held, in bytes.
+    /// Approximate memory held, in bytes (Embree's own is not counted).
     pub fn memory_bytes(&self) -> usize {
-        self.bvh.as_ref().map_or(0, Bvh4::memory_bytes)
+        match &self.backend {
+            Backend::Bvh4(bvh) => bvh.memory_bytes(),
+            _ => 0,
+        }
     }
 
     /// The closest hit with `0 < t < ray.t_max`, if any.
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.bvh.as_ref()?.intersect(ray)
+        match &self.backend {
+            Backend::Empty => None,
+            Backend::Bvh4(bvh) => bvh.intersect(ray),
+            #[cfg(feature = "embree")]
+            Backend::Embree(scene) => scene.intersect(ray),
+        }
     }
 
     /// True when any triangle lies on the ray with `0 < t < ray.t_max`.
+    #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.bvh.as_ref().is_some_and(|bvh| bvh.occluded(ray))
+        match &self.backend {
+            Backend::Empty => false,
+            Backend::Bvh4(bvh) => bvh.occluded(ray),
+            #[cfg(feature = "embree")]
+            Backend::Embree(scene) => scene.occluded(ray),
+        }
     }
+}
+
+/// obvhs's binary BVH (leaves of up to four triangles: one packet), collapsed four-wide.
+fn build_bvh4(triangles: &[[Vec3; 3]]) -> Bvh4 {
+    let prims: Vec<Triangle> =
+        triangles.iter().map(|t| Triangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
+    let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::medium_build() };
+    let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(&prims, params, &mut std::time::Duration::default());
+    Bvh4::from_bvh2(&bvh2, triangles)
 }
 
 #[cfg(test)]
@@ -118,48 +187,59 @@ mod tests {
             .collect()
     }
 
+    /// Every backend this build has, built over `tris`.
+    fn each_kind(tris: &[[Vec3; 3]]) -> impl Iterator<Item = (AccelKind, Accel)> {
+        AccelKind::ALL.iter().map(|&kind| (kind, Accel::build_kind(tris, kind)))
+    }
+
     #[test]
     fn accel_closest_hit_matches_brute_force() {
         let mut rng = Lcg(7);
         let tris = random_scene(&mut rng, 2000);
-        let accel = Accel::build(&tris);
-        let mut hits = 0;
-        for _ in 0..5000 {
-            let o = rng.vec(14.0);
-            let d = rng.vec(2.0).normalize();
-            let mut ray = Ray::new(o, d);
-            if rng.next() < 0.3 {
-                ray.t_max = rng.next() * 10.0;
+        for (kind, accel) in each_kind(&tris) {
+            let mut hits = 0;
+            for _ in 0..5000 {
+                let o = rng.vec(14.0);
+                let d = rng.vec(2.0).normalize();
+                let mut ray = Ray::new(o, d);
+                if rng.next() < 0.3 {
+                    ray.t_max = rng.next() * 10.0;
+                }
+                let expected = brute_force(&tris, &ray);
+                let got = accel.intersect(&ray);
+                assert_eq!(expected.map(|e| e.1), got.map(|g| g.triangle), "{kind:?}: ray {ray:?}");
+                if let (Some(e), Some(g)) = (expected, got) {
+                    if kind == AccelKind::Bvh4 {
+                        assert_eq!(e.0, g.t); // the same triangle test
+                    } else {
+                        assert!((e.0 - g.t).abs() <= 1e-5 * e.0.max(1.0), "{kind:?}: t {} vs {}", g.t, e.0);
+                    }
+                    let [a, b, c] = tris[g.triangle as usize];
+                    let p = a * (1.0 - g.b1 - g.b2) + b * g.b1 + c * g.b2;
+                    assert!(p.distance(ray.at(g.t)) < 1e-4, "barycentrics disagree with t");
+                    hits += 1;
+                }
+                assert_eq!(expected.is_some(), accel.occluded(&ray));
             }
-            let expected = brute_force(&tris, &ray);
-            let got = accel.intersect(&ray);
-            assert_eq!(expected.map(|e| e.1), got.map(|g| g.triangle), "ray {ray:?}");
-            if let (Some(e), Some(g)) = (expected, got) {
-                assert_eq!(e.0, g.t);
-                let [a, b, c] = tris[g.triangle as usize];
-                let p = a * (1.0 - g.b1 - g.b2) + b * g.b1 + c * g.b2;
-                assert!(p.distance(ray.at(g.t)) < 1e-4, "barycentrics disagree with t");
-                hits += 1;
-            }
-            assert_eq!(expected.is_some(), accel.occluded(&ray));
+            assert!(hits > 500, "the test scene should be hit often, got {hits}");
         }
-        assert!(hits > 500, "the test scene should be hit often, got {hits}");
     }
 
     #[test]
     fn accel_matches_brute_force_on_a_deep_lopsided_tree() {
         let tris = lopsided_scene();
-        let accel = Accel::build(&tris);
-        let mut rng = Lcg(11);
-        for i in 0..2000 {
-            // From far along the line, towards a point on a random triangle, or anywhere.
-            let o = Vec3::new(3e4 * rng.next(), 3.0 * rng.next() - 1.0, 3.0 * rng.next() - 1.0);
-            let [a, b, c] = tris[(rng.next() * tris.len() as f32) as usize % tris.len()];
-            let target = if i % 2 == 0 { (a + b + c) / 3.0 } else { rng.vec(2e4) };
-            let ray = Ray::new(o, target - o);
-            let expected = brute_force(&tris, &ray);
-            assert_eq!(expected.map(|e| e.1), accel.intersect(&ray).map(|h| h.triangle), "ray {ray:?}");
-            assert_eq!(expected.is_some(), accel.occluded(&ray));
+        for (kind, accel) in each_kind(&tris) {
+            let mut rng = Lcg(11);
+            for i in 0..2000 {
+                // From far along the line, towards a point on a random triangle, or anywhere.
+                let o = Vec3::new(3e4 * rng.next(), 3.0 * rng.next() - 1.0, 3.0 * rng.next() - 1.0);
+                let [a, b, c] = tris[(rng.next() * tris.len() as f32) as usize % tris.len()];
+                let target = if i % 2 == 0 { (a + b + c) / 3.0 } else { rng.vec(2e4) };
+                let ray = Ray::new(o, target - o);
+                let expected = brute_force(&tris, &ray);
+                assert_eq!(expected.map(|e| e.1), accel.intersect(&ray).map(|h| h.triangle), "{kind:?}: ray {ray:?}");
+                assert_eq!(expected.is_some(), accel.occluded(&ray));
+            }
         }
     }
 
@@ -179,23 +259,26 @@ mod tests {
             [p, p + Vec3::X, p + 2.0 * Vec3::X],
             [Vec3::new(-1.0, -1.0, -2.0), Vec3::new(1.0, -1.0, -2.0), Vec3::new(0.0, 1.0, -2.0)],
         ];
-        let accel = Accel::build(&tris);
-        let hit = accel.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z)).expect("the real triangle");
-        assert_eq!(hit.triangle, 2);
-        assert!((hit.t - 2.0).abs() < 1e-6);
-        // A ray along the collapsed triangles hits nothing and produces no NaN.
-        assert!(accel.intersect(&Ray::new(p - Vec3::X, Vec3::X)).is_none());
+        for (kind, accel) in each_kind(&tris) {
+            let hit = accel.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z)).expect("the real triangle");
+            assert_eq!(hit.triangle, 2, "{kind:?}");
+            assert!((hit.t - 2.0).abs() < 1e-6, "{kind:?}");
+            // A ray along the collapsed triangles hits nothing and produces no NaN.
+            assert!(accel.intersect(&Ray::new(p - Vec3::X, Vec3::X)).is_none(), "{kind:?}");
+        }
     }
 
     #[test]
     fn accel_hits_with_negative_zero_direction_components() {
         // Zero direction components of either sign: the slab test must not make NaNs of them.
         let tri = [Vec3::new(-1.0, -1.0, -2.0), Vec3::new(1.0, -1.0, -2.0), Vec3::new(0.0, 1.0, -2.0)];
-        let accel = Accel::build(&[tri]);
-        for d in [Vec3::new(-0.0, -0.0, -1.0), Vec3::new(-0.0, 0.0, -1.0), Vec3::new(0.0, -0.0, -1.0)] {
-            let hit = accel.intersect(&Ray::new(Vec3::ZERO, d));
-            assert_eq!(hit.map(|h| h.t), Some(2.0), "direction {d:?}");
-            assert!(accel.occluded(&Ray::new(Vec3::ZERO, d)));
+        for (kind, accel) in each_kind(&[tri]) {
+            for d in [Vec3::new(-0.0, -0.0, -1.0), Vec3::new(-0.0, 0.0, -1.0), Vec3::new(0.0, -0.0, -1.0)] {
+                let hit = accel.intersect(&Ray::new(Vec3::ZERO, d));
+                let t = hit.map(|h| h.t).unwrap_or(f32::NAN);
+                assert!((t - 2.0).abs() < 1e-6, "{kind:?}: direction {d:?}, t {t}");
+                assert!(accel.occluded(&Ray::new(Vec3::ZERO, d)));
+            }
         }
     }
 
@@ -211,13 +294,14 @@ mod tests {
                 [Vec3::ZERO, Vec3::new(a0.cos(), a0.sin(), 0.0), Vec3::new(a1.cos(), a1.sin(), 0.0)]
             })
             .collect();
-        let accel = Accel::build(&tris);
-        for i in 0..n {
-            let a = i as f32 / n as f32 * std::f32::consts::TAU;
-            for r in [0.0, 0.1, 0.37, 0.9] {
-                let target = Vec3::new(a.cos() * r, a.sin() * r, 0.0);
-                let o = Vec3::new(0.3, -0.2, 2.0);
-                assert!(accel.intersect(&Ray::new(o, target - o)).is_some(), "missed {target}");
+        for (kind, accel) in each_kind(&tris) {
+            for i in 0..n {
+                let a = i as f32 / n as f32 * std::f32::consts::TAU;
+                for r in [0.0, 0.1, 0.37, 0.9] {
+                    let target = Vec3::new(a.cos() * r, a.sin() * r, 0.0);
+                    let o = Vec3::new(0.3, -0.2, 2.0);
+                    assert!(accel.intersect(&Ray::new(o, target - o)).is_some(), "{kind:?} missed {target}");
+                }
             }
         }
     }
