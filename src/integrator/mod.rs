@@ -69,7 +69,7 @@ pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn F
     let (w, h) = crop.size();
     let film = Mutex::new(Film::new(w as usize, h as usize, aovs));
     let stride = film.lock().expect("fresh").aov_stride();
-    let tracer = PathTracer::new(scene, aovs.contains(&Aov::Footprint));
+    let tracer = PathTracer::new(scene, !aovs.is_empty(), aovs.contains(&Aov::Footprint));
     let total = w as u64 * h as u64 * s.spp as u64;
     let done = AtomicU64::new(0);
     let tiles: Vec<(u32, u32)> =

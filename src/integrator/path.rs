@@ -35,6 +35,8 @@ pub struct PathTracer<'a> {
     rr_depth: u32,
     /// Per material: whether a hit on it needs the texture footprint.
     needs_footprint: Vec<bool>,
+    /// Whether the first hit is recorded at all (some AOV is written).
+    record_first_hit: bool,
     /// Whether the first hit's footprint is recorded (the footprint AOV).
     record_footprint: bool,
 }
@@ -47,9 +49,9 @@ struct PreviousVertex {
 }
 
 impl<'a> PathTracer<'a> {
-    /// A tracer with the scene's settings; `record_footprint` computes the first hit's texture
-    /// footprint even where no filtered texture needs it.
-    pub fn new(scene: &'a Scene, record_footprint: bool) -> Self {
+    /// A tracer with the scene's settings; `record_first_hit` fills `trace`'s `first_hit`, and
+    /// `record_footprint` computes its texture footprint even where no filtered texture needs it.
+    pub fn new(scene: &'a Scene, record_first_hit: bool, record_footprint: bool) -> Self {
         let needs_footprint = scene
             .materials
             .iter()
@@ -60,11 +62,13 @@ impl<'a> PathTracer<'a> {
             max_depth: scene.settings.max_depth.unwrap_or(u32::MAX),
             rr_depth: scene.settings.rr_depth,
             needs_footprint,
+            record_first_hit,
             record_footprint,
         }
     }
 
-    /// Radiance arriving along the camera ray `ray` (with differentials `diff`).
+    /// Radiance arriving along the camera ray `ray` (with differentials `diff`); `first_hit` is
+    /// filled where the tracer records first hits and the ray hits something.
     pub fn trace(
         &self,
         mut ray: Ray,
@@ -126,7 +130,7 @@ impl<'a> PathTracer<'a> {
             let shading = material.shading(&scene.textures, &ctx, base, si.dpdu, si.dpdv);
             let frame = shading.frame;
             let wo = frame.to_local(si.wo);
-            if depth == 0 {
+            if depth == 0 && self.record_first_hit {
                 *first_hit = Some(FirstHit {
                     albedo: bsdf.albedo(),
                     normal: frame.n,
