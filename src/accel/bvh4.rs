@@ -109,7 +109,7 @@ impl Bvh4 {
     pub(super) fn memory_bytes(&self) -> usize {
         self.nodes.len() * size_of::<Node>()
             + self.leaves.len() * size_of::<Leaf>()
-            + self.packets.len() * (size_of::<TrianglePacket>() + 16)
+            + self.packets.len() * (size_of::<TrianglePacket>() + size_of::<[u32; 4]>())
     }
 
     /// The closest hit with `0 < t < ray.t_max`.
@@ -117,15 +117,13 @@ impl Bvh4 {
         let shear = RayShear::new(ray);
         let mut closest: Option<Hit> = None;
         self.traverse::<true>(ray, |packets, t_max| {
-            let mut found = false;
             for p in packets {
                 if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&self.packets[p], *t_max) {
                     closest = Some(Hit { triangle: self.packet_triangles[p][lane], t, b1, b2 });
                     *t_max = t;
-                    found = true;
                 }
             }
-            found
+            false
         });
         closest
     }
@@ -141,10 +139,10 @@ impl Bvh4 {
         blocked
     }
 
-    /// Visit the leaves whose boxes the ray enters, calling `leaf(packets, t_max)`. With
-    /// `CLOSEST`, children are visited nearest first, `leaf` returning true means it shortened
-    /// `t_max` to a hit, and boxes beyond it are skipped; without, `leaf` returning true ends
-    /// the traversal (a shadow ray needs any hit, not the nearest).
+    /// Visit the leaves whose boxes the ray enters, calling `leaf(packets, t_max)`, which may
+    /// shorten `t_max` to a hit and returns true to end the traversal. With `CLOSEST`, children
+    /// are visited nearest first and boxes beyond `t_max` are skipped; without, in any order (a
+    /// shadow ray needs any hit, not the nearest).
     #[inline(always)]
     fn traverse<const CLOSEST: bool>(&self, ray: &Ray, mut leaf: impl FnMut(std::ops::Range<usize>, &mut f32) -> bool) {
         let boxes = RayBoxes::new(ray);
@@ -187,7 +185,7 @@ impl Bvh4 {
                     }
                 } else {
                     let Leaf { first, count } = self.leaves[(current & !LEAF) as usize];
-                    if leaf(first as usize..(first + count) as usize, &mut t_max) && !CLOSEST {
+                    if leaf(first as usize..(first + count) as usize, &mut t_max) {
                         return;
                     }
                 }

@@ -168,7 +168,7 @@ mod tests {
     }
 
     /// Triangles along a line at exponentially growing distances: a deep, lopsided tree (obvhs's
-    /// binary BVH over it is 114 levels deep), whose traversal overflows the inline stack.
+    /// binary BVH over it is 114 levels deep), whose traversal stack grows past 32 entries.
     pub(super) fn lopsided_scene() -> Vec<[Vec3; 3]> {
         (0..3000)
             .map(|i| {

@@ -158,8 +158,7 @@ fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Re
     let scene_path = scene_dir.join("brushed_metal.toml");
     let mut scene = load_scene(&scene_path, &SceneOverrides::default())?;
     let s = scene.settings;
-    let g = &scene.geometry;
-    let triangles: Vec<_> = (0..g.triangles.len()).map(|t| g.triangle_positions(t)).collect();
+    let triangles = scene.geometry.all_triangle_positions();
     for &kind in AccelKind::ALL {
         scene.accel = Accel::build_kind(&triangles, kind);
         let mut rates = Vec::new();

@@ -198,8 +198,7 @@ impl<'a> Loader<'a> {
             None => None,
         };
         let camera = self.camera(&desc.camera, &settings)?;
-        let triangles: Vec<[Vec3; 3]> = (0..geometry.triangles.len()).map(|t| geometry.triangle_positions(t)).collect();
-        let accel = Accel::build(&triangles);
+        let accel = Accel::build(&geometry.all_triangle_positions());
         Ok(Scene {
             path: self.path.to_path_buf(),
             settings,

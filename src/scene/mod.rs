@@ -108,6 +108,11 @@ impl Geometry {
         self.triangles[i].map(|v| self.positions[v as usize])
     }
 
+    /// Vertex positions of every triangle, in order: what the accelerator is built over.
+    pub fn all_triangle_positions(&self) -> Vec<[Vec3; 3]> {
+        (0..self.triangles.len()).map(|t| self.triangle_positions(t)).collect()
+    }
+
     /// All vertex data of triangle `i`.
     #[inline]
     pub fn triangle_vertices(&self, i: usize) -> TriangleVertices {
