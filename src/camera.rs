@@ -26,8 +26,10 @@ pub struct PerspectiveCamera {
     height: u32,
     /// The field of view as given, in degrees, and the axis it spans.
     fov: (f32, FovAxis),
-    /// tan(half field of view) along x and y.
-    tan_half: Vec2,
+    /// World direction (not normalised) through the film's top-left corner, and its change
+    /// for one pixel right and one pixel down: directions are affine in the film position.
+    corner_direction: Vec3,
+    pixel_step: [Vec3; 2],
     /// Scale of the ray differentials: max(1/8, 1/sqrt(spp)) (pbrt-v4), since the footprint of a
     /// pixel is covered by spp samples rather than one.
     differential_scale: f32,
@@ -58,7 +60,11 @@ impl PerspectiveCamera {
             width,
             height,
             fov: (fov_degrees, fov_axis),
-            tan_half,
+            corner_direction: to_world.transform_vector3(Vec3::new(-tan_half.x, tan_half.y, -1.0)),
+            pixel_step: [
+                to_world.transform_vector3(Vec3::new(2.0 * tan_half.x / width as f32, 0.0, 0.0)),
+                to_world.transform_vector3(Vec3::new(0.0, -2.0 * tan_half.y / height as f32, 0.0)),
+            ],
             differential_scale: (1.0 / (spp.max(1) as f32).sqrt()).max(0.125),
             min_direction_step: Vec2::ZERO,
         };
@@ -108,19 +114,20 @@ impl PerspectiveCamera {
     /// ((0, 0) = top-left corner of the image).
     #[inline]
     fn direction(&self, film: Vec2) -> Vec3 {
-        let ndc = Vec2::new(2.0 * film.x / self.width as f32 - 1.0, 1.0 - 2.0 * film.y / self.height as f32);
-        let local = Vec3::new(ndc.x * self.tan_half.x, ndc.y * self.tan_half.y, -1.0);
-        self.to_world.transform_vector3(local)
+        self.corner_direction + self.pixel_step[0] * film.x + self.pixel_step[1] * film.y
     }
 
     /// The ray through the film point `film` (in pixels), with differentials to the points one
     /// pixel right and one pixel down, scaled by max(1/8, 1/sqrt(spp)).
     pub fn generate_ray(&self, film: Vec2) -> (Ray, RayDifferential) {
-        let d = self.direction(film).normalize();
-        let dx = self.direction(film + Vec2::X).normalize();
-        let dy = self.direction(film + Vec2::Y).normalize();
-        let ray = Ray::new(self.position, d);
-        let diff = RayDifferential { rx_o: self.position, rx_d: dx, ry_o: self.position, ry_d: dy };
+        let d = self.direction(film);
+        let ray = Ray::new(self.position, d.normalize());
+        let diff = RayDifferential {
+            rx_o: self.position,
+            rx_d: (d + self.pixel_step[0]).normalize(),
+            ry_o: self.position,
+            ry_d: (d + self.pixel_step[1]).normalize(),
+        };
         (ray, diff.scaled(&ray, self.differential_scale))
     }
 

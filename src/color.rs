@@ -3,10 +3,10 @@
 //! 8-bit colour textures are sRGB-decoded once on load ([`srgb_to_linear`]); PNG output is
 //! sRGB-encoded ([`linear_to_srgb`]). Nothing else converts colours.
 
-use glam::Vec3;
+use glam::Vec3A;
 
 /// Linear Rec.709 RGB radiance, reflectance or weight.
-pub type Rgb = Vec3;
+pub type Rgb = Vec3A;
 
 /// Relative luminance of a linear Rec.709 colour (ITU-R BT.709 weights).
 #[inline]

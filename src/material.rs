@@ -48,7 +48,7 @@ impl ColorParam {
     pub fn eval(&self, textures: &[Texture], ctx: &TexCtx) -> Rgb {
         match *self {
             ColorParam::Value(c) => c,
-            ColorParam::Texture { id, scale } => textures[id.0 as usize].eval(ctx).truncate() * scale,
+            ColorParam::Texture { id, scale } => Rgb::from_vec4(textures[id.0 as usize].eval(ctx)) * scale,
         }
     }
 }

@@ -53,7 +53,7 @@ fn environment_map_sample_pdf_and_radiance_are_consistent() {
 
 #[test]
 fn constant_environment_sampling_is_uniform_chi2() {
-    let env = Environment::Constant(Vec3::ONE);
+    let env = Environment::Constant(tessera::color::Rgb::ONE);
     let outcome = Chi2::default().run(22, |_, u| env.sample(u).map(|s| s.wi), |w| env.pdf(w));
     assert!(outcome.p_value > sidak(TESTS) && (outcome.integral - 1.0).abs() < 1e-3, "{outcome:?}");
 }
@@ -68,7 +68,7 @@ fn area_light_sampling_matches_pdf_chi2() {
         [Vec3::new(0.5, 1.0, 0.3), Vec3::new(0.8, 2.0, 0.4), Vec3::new(1.5, 1.2, 0.5)],
         [Vec3::new(-1.5, -1.0, 0.2), Vec3::new(-1.0, -2.0, 0.2), Vec3::new(-0.5, -1.5, 0.3)],
     ];
-    let light = AreaLight::new(quad.to_vec(), Vec3::ONE);
+    let light = AreaLight::new(quad.to_vec(), tessera::color::Rgb::ONE);
     let accel = Accel::build(&quad);
     let p = Vec3::new(0.1, 0.2, -0.3);
     let pdf = |w: Vec3| {

@@ -14,7 +14,7 @@
 use super::Hit;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
 use crate::geometry::Ray;
-use glam::{Vec3, Vec4};
+use glam::{Vec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
 /// Children of a node that are leaves: `LEAF | index into Bvh4::leaves`.
@@ -62,12 +62,15 @@ impl RayBoxes {
     fn new(ray: &Ray) -> Self {
         // A zero component becomes a tiny one of the same sign: its reciprocal stays finite,
         // so that no 0 * inf makes a NaN in the slab test.
-        let inv = |d: f32| 1.0 / if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d };
-        let inv_d = [inv(ray.d.x), inv(ray.d.y), inv(ray.d.z)];
+        let d = Vec3A::from(ray.d);
+        let tiny = Vec3A::splat(1e-20);
+        let inv_d = Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d).recip();
+        let o_inv_d = Vec3A::from(ray.o) * inv_d;
+        let negative = inv_d.cmplt(Vec3A::ZERO).bitmask() as usize;
         RayBoxes {
-            near_is_max: inv_d.map(|i| usize::from(i < 0.0)),
-            inv_d: inv_d.map(Vec4::splat),
-            o_inv_d: std::array::from_fn(|a| Vec4::splat(ray.o[a] * inv_d[a])),
+            near_is_max: [negative & 1, (negative >> 1) & 1, negative >> 2],
+            inv_d: [Vec4::splat(inv_d.x), Vec4::splat(inv_d.y), Vec4::splat(inv_d.z)],
+            o_inv_d: [Vec4::splat(o_inv_d.x), Vec4::splat(o_inv_d.y), Vec4::splat(o_inv_d.z)],
         }
     }
 

@@ -49,8 +49,8 @@ pub(super) struct RayShear {
 
 impl RayShear {
     pub(super) fn new(ray: &Ray) -> Self {
-        let d = ray.d;
-        let a = d.abs();
+        let (d, o) = (ray.d.to_array(), ray.o.to_array());
+        let a = ray.d.abs();
         let kz = if a.x >= a.y && a.x >= a.z {
             0
         } else if a.y >= a.z {
@@ -58,19 +58,16 @@ impl RayShear {
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Keep the winding: swap when the dominant component is negative.
+        // The other two axes in cyclic order, swapped when the dominant component is negative
+        // so that the winding is kept.
+        const CYCLIC: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
+        let [mut kx, mut ky] = CYCLIC[kz];
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
         let sz = 1.0 / d[kz];
         let k = [kx, ky, kz];
-        RayShear {
-            k,
-            origin: k.map(|axis| Vec4::splat(ray.o[axis])),
-            shear: [d[kx] * sz, d[ky] * sz, sz].map(Vec4::splat),
-        }
+        RayShear { k, origin: k.map(|axis| Vec4::splat(o[axis])), shear: [d[kx] * sz, d[ky] * sz, sz].map(Vec4::splat) }
     }
 
     /// The closest hit with `0 < t < t_max` among the packet's triangles, or None. Ties go to

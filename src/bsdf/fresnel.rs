@@ -42,22 +42,20 @@ pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> FresnelDielectric {
 /// the exterior, per channel, at incident cosine `cos_theta_i` in [0, 1] (K. D. Moeller,
 /// "Optics", 1988; the form Mitsuba 3 uses).
 pub fn fresnel_conductor(cos_theta_i: f32, eta: Rgb, k: Rgb) -> Rgb {
+    // The three channels at once, one per SIMD lane.
     let c2 = cos_theta_i * cos_theta_i;
     let s2 = 1.0 - c2;
     let s4 = s2 * s2;
-    let channel = |eta: f32, k: f32| {
-        let temp = eta * eta - k * k - s2;
-        let a2pb2 = (temp * temp + 4.0 * k * k * eta * eta).max(0.0).sqrt();
-        let a = (0.5 * (a2pb2 + temp)).max(0.0).sqrt();
-        let t1 = a2pb2 + c2;
-        let t2 = 2.0 * cos_theta_i * a;
-        let rs = (t1 - t2) / (t1 + t2);
-        let t3 = a2pb2 * c2 + s4;
-        let t4 = t2 * s2;
-        let rp = rs * (t3 - t4) / (t3 + t4);
-        0.5 * (rs + rp)
-    };
-    Rgb::new(channel(eta.x, k.x), channel(eta.y, k.y), channel(eta.z, k.z))
+    let temp = eta * eta - k * k - s2;
+    let a2pb2 = (temp * temp + 4.0 * k * k * eta * eta).max(Rgb::ZERO).sqrt();
+    let a = (0.5 * (a2pb2 + temp)).max(Rgb::ZERO).sqrt();
+    let t1 = a2pb2 + c2;
+    let t2 = 2.0 * cos_theta_i * a;
+    let rs = (t1 - t2) / (t1 + t2);
+    let t3 = a2pb2 * c2 + s4;
+    let t4 = t2 * s2;
+    let rp = rs * (t3 - t4) / (t3 + t4);
+    0.5 * (rs + rp)
 }
 
 /// Schlick's approximation F0 + (1 - F0)(1 - cos)^5, the Fresnel term of glTF's metallic

@@ -65,7 +65,7 @@ impl EnvironmentMap {
             .map(|k| {
                 let (x, y) = (k % w, (k / w).min(image.height - 1));
                 let sin_theta = (PI * y as f32 / (h - 1) as f32).sin().max(0.0);
-                luminance(image.pixel(x, y).truncate()).max(0.0) * sin_theta
+                luminance(Rgb::from_vec4(image.pixel(x, y))).max(0.0) * sin_theta
             })
             .collect();
         let cells: Vec<f32> = (0..w * (h - 1))
@@ -102,7 +102,7 @@ impl EnvironmentMap {
         let (c0, c1) = (col(x0), col(x0 + 1.0));
         let r0 = y0 as usize;
         let r1 = (r0 + 1).min(h - 1);
-        let px = |c: usize, r: usize| self.image.pixel(c, r).truncate();
+        let px = |c: usize, r: usize| Rgb::from_vec4(self.image.pixel(c, r));
         let top = px(c0, r0) * (1.0 - fx) + px(c1, r0) * fx;
         let bottom = px(c0, r1) * (1.0 - fx) + px(c1, r1) * fx;
         (top * (1.0 - fy) + bottom * fy) * self.scale

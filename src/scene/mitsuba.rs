@@ -119,7 +119,7 @@ impl Exporter<'_> {
                     BakeKind::Color(scale) => {
                         let scale =
                             Rgb::new(f32::from_bits(scale[0]), f32::from_bits(scale[1]), f32::from_bits(scale[2]));
-                        let values: Vec<Rgb> = pixels.map(|(x, y)| image.pixel(x, y).truncate() * scale).collect();
+                        let values: Vec<Rgb> = pixels.map(|(x, y)| Rgb::from_vec4(image.pixel(x, y)) * scale).collect();
                         let plane = |c: usize| values.iter().map(|v| v[c]).collect::<Vec<f32>>();
                         let file = format!("textures/texture{}_rgb{}.exr", id.0, self.baked.len());
                         (file, vec![("R".into(), plane(0)), ("G".into(), plane(1)), ("B".into(), plane(2))])
