@@ -270,21 +270,23 @@ fn variance_preserving_blending_keeps_a_gaussian_exemplar_variance() {
 #[test]
 fn histogram_preserving_blending_keeps_the_exemplar_histogram() {
     // A skewed exemplar (a lognormal field): variance-preserving blending alone would pull its
-    // histogram towards a Gaussian. The field is smooth (3 texels) so that bilinear lookups
-    // between texels hardly narrow it.
+    // histogram towards a Gaussian. The field is smooth (3 texels), and the reference is the
+    // exemplar seen through the same bilinear lookups, which narrow it a little.
     let n = 128;
     let values: Vec<f32> = gaussian_field(n, 3.0, 11).iter().map(|v| ((v - 0.5) * 10.0).exp()).collect();
     let quantiles = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         [0.05, 0.25, 0.5, 0.75, 0.95].map(|q| v[(q * (v.len() - 1) as f64) as usize])
     };
-    // The exemplar's histogram: its texels.
-    let reference = quantiles(values.iter().map(|&v| v as f64).collect());
-    let spread = reference[4] - reference[0];
     let exemplar = image_texture(n, values, Filter::None);
+    // The exemplar's histogram as the same (bilinear) point lookups see it.
+    let reference = quantiles(samples(&exemplar, 800_000, 1.0, 12));
+    let spread = reference[4] - reference[0];
+    // 800k lookups: over seeds 13-20 the histogram-preserving error is 0.011-0.016 (the
+    // method's own error; 200k lookups add +-0.004 of noise), variance-preserving 0.064.
     let error = |blend: Blend| {
         let t = tb(&synthesis(Tiling::Hexagonal, blend, None), &exemplar);
-        let q = quantiles(samples(&t, 200_000, 300.0, 13));
+        let q = quantiles(samples(&t, 800_000, 300.0, 13));
         q.iter().zip(&reference).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / spread
     };
     let histogram = error(Blend::HistogramPreserving);

@@ -136,7 +136,7 @@ impl Bvh4 {
         let shear = RayShear::new(ray);
         let mut blocked = false;
         self.traverse::<false>(ray, |mut packets, t_max| {
-            blocked = packets.any(|p| shear.intersect(&self.packets[p], *t_max).is_some());
+            blocked = packets.any(|p| shear.occludes(&self.packets[p], *t_max));
             blocked
         });
         blocked
@@ -163,7 +163,27 @@ impl Bvh4 {
                             current = node.children[mask.trailing_zeros() as usize];
                             continue;
                         }
-                        // Two to four children: push all but the nearest, farthest first.
+                        let mut rest = mask & (mask - 1);
+                        if !CLOSEST {
+                            // Any order: visit the first, push the others.
+                            current = node.children[mask.trailing_zeros() as usize];
+                            while rest != 0 {
+                                let i = rest.trailing_zeros() as usize;
+                                rest &= rest - 1;
+                                stack.push((node.children[i], 0.0));
+                            }
+                            continue;
+                        }
+                        if rest & (rest - 1) == 0 {
+                            // Two: visit the nearer, push the other (the order the sort below
+                            // would give, ties included).
+                            let (i, j) = (mask.trailing_zeros() as usize, rest.trailing_zeros() as usize);
+                            let (near, far) = if t_near[i] < t_near[j] { (i, j) } else { (j, i) };
+                            stack.push((node.children[far], t_near[far]));
+                            current = node.children[near];
+                            continue;
+                        }
+                        // Three or four: push all but the nearest, farthest first.
                         let mut hits = [(0u32, 0.0f32); 4];
                         let mut n = 0;
                         while mask != 0 {
@@ -172,14 +192,12 @@ impl Bvh4 {
                             hits[n] = (node.children[i], t_near[i]);
                             n += 1;
                         }
-                        if CLOSEST {
-                            // Insertion sort, farthest first; stable, so that ties keep child order.
-                            for i in 1..n {
-                                let mut j = i;
-                                while j > 0 && hits[j - 1].1 < hits[j].1 {
-                                    hits.swap(j - 1, j);
-                                    j -= 1;
-                                }
+                        // Insertion sort, farthest first; stable, so that ties keep child order.
+                        for i in 1..n {
+                            let mut j = i;
+                            while j > 0 && hits[j - 1].1 < hits[j].1 {
+                                hits.swap(j - 1, j);
+                                j -= 1;
                             }
                         }
                         stack.extend_from_slice(&hits[..n - 1]);

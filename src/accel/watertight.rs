@@ -37,6 +37,15 @@ pub(super) struct PacketHit {
     pub b2: f32,
 }
 
+/// The lanes of a packet that a ray hits: distances, and barycentrics scaled by `det`.
+struct LaneHits {
+    valid: BVec4A,
+    t: Vec4,
+    v: Vec4,
+    w: Vec4,
+    det: Vec4,
+}
+
 /// Per-ray constants of the test: the axis permutation, and the origin and shear in permuted
 /// axes, splatted over the four lanes.
 pub(super) struct RayShear {
@@ -74,6 +83,22 @@ impl RayShear {
     /// the lowest lane.
     #[inline(always)]
     pub(super) fn intersect(&self, packet: &TrianglePacket, t_max: f32) -> Option<PacketHit> {
+        let LaneHits { valid, t, v, w, det } = self.lane_hits(packet, t_max)?;
+        let lane = closest_lane(valid, t);
+        let det = det.to_array()[lane];
+        Some(PacketHit { lane, t: t.to_array()[lane], b1: v.to_array()[lane] / det, b2: w.to_array()[lane] / det })
+    }
+
+    /// Whether any of the packet's triangles lies on the ray with `0 < t < t_max`.
+    #[inline(always)]
+    pub(super) fn occludes(&self, packet: &TrianglePacket, t_max: f32) -> bool {
+        self.lane_hits(packet, t_max).is_some()
+    }
+
+    /// The lanes hit with `0 < t < t_max`, with their distances and scaled barycentrics; None
+    /// when no lane is hit.
+    #[inline(always)]
+    fn lane_hits(&self, packet: &TrianglePacket, t_max: f32) -> Option<LaneHits> {
         let [kx, ky, kz] = self.k;
         let [sx, sy, sz] = self.shear;
         // Vertices relative to the origin, permuted and sheared: the ray is now the +z axis.
@@ -111,12 +136,7 @@ impl RayShear {
         let t = (u * az + v * bz + w * cz) / det;
         // A zero, infinite or NaN determinant gives a t that fails these comparisons.
         let valid = !(negative & positive) & det.cmpne(zero) & t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
-        if !valid.any() {
-            return None;
-        }
-        let lane = closest_lane(valid, t);
-        let det = det.to_array()[lane];
-        Some(PacketHit { lane, t: t.to_array()[lane], b1: v.to_array()[lane] / det, b2: w.to_array()[lane] / det })
+        valid.any().then_some(LaneHits { valid, t, v, w, det })
     }
 }
 

@@ -32,26 +32,34 @@ impl Sampler {
         Sampler { key, dimension: 0 }
     }
 
-    /// The number of dimensions drawn so far.
-    pub fn dimension(&self) -> u32 {
-        self.dimension
+    /// The next draw's 64 hashed bits.
+    #[inline]
+    fn next_bits(&mut self) -> u64 {
+        let bits = mix64(self.key ^ (self.dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        self.dimension += 1;
+        bits
     }
 
     /// The next uniform number in [0, 1).
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
-        let bits = mix64(self.key ^ (self.dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        self.dimension += 1;
         // The top 24 bits make every float in [0, 1) with spacing 2^-24 equally likely.
-        (bits >> 40) as f32 * (1.0 / 16_777_216.0)
+        unit_from_24_bits(self.next_bits() >> 40)
     }
 
-    /// The next two uniform numbers.
+    /// The next two uniform numbers, from the top and the next 24 bits of one hash: the
+    /// finaliser mixes every output bit with every input bit, so the two are independent.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        let x = self.next_1d();
-        Vec2::new(x, self.next_1d())
+        let bits = self.next_bits();
+        Vec2::new(unit_from_24_bits(bits >> 40), unit_from_24_bits((bits >> 16) & 0xff_ffff))
     }
+}
+
+/// A 24-bit integer as a float in [0, 1) (exact: floats hold 24-bit integers).
+#[inline(always)]
+fn unit_from_24_bits(bits: u64) -> f32 {
+    bits as f32 * (1.0 / 16_777_216.0)
 }
 
 #[cfg(test)]
@@ -98,5 +106,24 @@ mod tests {
         assert!((mean - 0.5).abs() < 3e-3, "mean {mean}");
         assert!((var - 1.0 / 12.0).abs() < 2e-3, "variance {var}");
         assert!((cross / n).abs() < 1e-3, "lag-1 covariance {}", cross / n);
+    }
+
+    #[test]
+    fn sampler_2d_draws_are_uniform_on_the_square() {
+        // Chi-square of 2D draws over a 16 x 16 grid (255 degrees of freedom): a correlation
+        // between the two halves of a hash would crowd some cells.
+        let (n, cells) = (256_000usize, 16usize);
+        let mut counts = vec![0u32; cells * cells];
+        for i in 0..n {
+            let mut s = Sampler::new(2, i as u64 / 4, (i % 4) as u32);
+            s.next_1d();
+            let u = s.next_2d();
+            assert!((0.0..1.0).contains(&u.x) && (0.0..1.0).contains(&u.y));
+            counts[(u.y * cells as f32) as usize * cells + (u.x * cells as f32) as usize] += 1;
+        }
+        let expected = (n / (cells * cells)) as f64;
+        let chi2: f64 = counts.iter().map(|&c| (c as f64 - expected).powi(2) / expected).sum();
+        // The 0.999 quantile of chi-square with 255 degrees of freedom is about 330.
+        assert!(chi2 < 330.0, "chi-square {chi2}");
     }
 }
