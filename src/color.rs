@@ -5,7 +5,8 @@
 
 use glam::Vec3A;
 
-/// Linear Rec.709 RGB radiance, reflectance or weight.
+/// Linear Rec.709 RGB radiance, reflectance or weight; a SIMD vector (glam's `Vec3A`), so that
+/// colour arithmetic works on the three channels at once.
 pub type Rgb = Vec3A;
 
 /// Relative luminance of a linear Rec.709 colour (ITU-R BT.709 weights).
