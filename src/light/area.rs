@@ -13,6 +13,8 @@ pub struct AreaLight {
     /// Radiance emitted towards the front side.
     pub radiance: Rgb,
     triangles: Vec<[Vec3; 3]>,
+    /// Unit geometric normal of each triangle (the front side).
+    normals: Vec<Vec3>,
     by_area: Distribution1D,
     area: f32,
 }
@@ -20,9 +22,11 @@ pub struct AreaLight {
 impl AreaLight {
     /// A light over the given triangles (world space).
     pub fn new(triangles: Vec<[Vec3; 3]>, radiance: Rgb) -> Self {
-        let areas: Vec<f32> = triangles.iter().map(|[a, b, c]| 0.5 * (*b - *a).cross(*c - *a).length()).collect();
+        let cross: Vec<Vec3> = triangles.iter().map(|[a, b, c]| (*b - *a).cross(*c - *a)).collect();
+        let areas: Vec<f32> = cross.iter().map(|c| 0.5 * c.length()).collect();
         let area = areas.iter().sum();
-        AreaLight { radiance, by_area: Distribution1D::new(&areas), triangles, area }
+        let normals = cross.iter().map(|c| c.normalize()).collect();
+        AreaLight { radiance, by_area: Distribution1D::new(&areas), triangles, normals, area }
     }
 
     /// Total surface area.
@@ -42,7 +46,7 @@ impl AreaLight {
         let [a, b, c] = self.triangles[pick.index];
         let bary = warp::square_to_uniform_triangle(Vec2::new(pick.u_remapped, u.y));
         let q = a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y;
-        let n = (b - a).cross(c - a).normalize();
+        let n = self.normals[pick.index];
         let to_light = q - p;
         let dist2 = to_light.length_squared();
         let wi = to_light / dist2.sqrt();
