@@ -7,7 +7,7 @@ pub use path::{FirstHit, PathTracer};
 
 use crate::color::Rgb;
 use crate::image::{Aov, Film, PixelSum};
-use crate::sampling::Sampler;
+use crate::sampling::PixelKey;
 use crate::scene::Scene;
 use glam::Vec2;
 use rayon::prelude::*;
@@ -82,8 +82,9 @@ pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn F
                 let (px, py) = (crop.x0 + fx, crop.y0 + fy);
                 let pixel_index = py as u64 * s.width as u64 + px as u64;
                 let mut sum = PixelSum::new(stride);
+                let key = PixelKey::new(s.seed, pixel_index);
                 for i in 0..s.spp {
-                    let mut sampler = Sampler::new(s.seed, pixel_index, i);
+                    let mut sampler = key.sampler(i);
                     let film_pos = Vec2::new(px as f32, py as f32) + sampler.next_2d();
                     let (ray, diff) = scene.camera.generate_ray(film_pos);
                     let mut first_hit = None;

@@ -5,8 +5,8 @@ mod rng;
 pub mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
-pub use rng::Sampler;
 pub(crate) use rng::mix64;
+pub use rng::{PixelKey, Sampler};
 
 /// The power heuristic with exponent 2 for multiple importance sampling (Veach 1997, Eq. 9.13):
 /// the weight of a sample drawn with density `pdf_a` when `pdf_b` could also have drawn it.

@@ -14,6 +14,24 @@ pub struct Sampler {
     dimension: u32,
 }
 
+/// The part of the samplers' key that one pixel's samples share: (seed, pixel), hashed once.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelKey(u64);
+
+impl PixelKey {
+    /// The key of pixel `pixel` (a linear pixel index) under `seed`.
+    pub fn new(seed: u64, pixel: u64) -> Self {
+        let key = mix64(seed ^ 0x9e37_79b9_7f4a_7c15);
+        PixelKey(mix64(key ^ pixel.wrapping_mul(0xd1b5_4a32_d192_ed03)))
+    }
+
+    /// The sampler of sample `sample` of this pixel: the same as [`Sampler::new`].
+    #[inline]
+    pub fn sampler(self, sample: u32) -> Sampler {
+        Sampler { key: mix64(self.0 ^ (sample as u64).wrapping_mul(0x8cb9_2ba7_2f3d_8dd7)), dimension: 0 }
+    }
+}
+
 /// A 64-bit finaliser with full avalanche (Stafford's "Mix13" variant of the MurmurHash3
 /// finaliser, as used by SplitMix64).
 #[inline(always)]
@@ -26,10 +44,7 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
 impl Sampler {
     /// The sampler of sample `sample` of pixel `pixel` (a linear pixel index) under `seed`.
     pub fn new(seed: u64, pixel: u64, sample: u32) -> Self {
-        let key = mix64(seed ^ 0x9e37_79b9_7f4a_7c15);
-        let key = mix64(key ^ pixel.wrapping_mul(0xd1b5_4a32_d192_ed03));
-        let key = mix64(key ^ (sample as u64).wrapping_mul(0x8cb9_2ba7_2f3d_8dd7));
-        Sampler { key, dimension: 0 }
+        PixelKey::new(seed, pixel).sampler(sample)
     }
 
     /// The next draw's 64 hashed bits.
