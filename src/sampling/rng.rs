@@ -5,9 +5,10 @@ use glam::Vec2;
 
 /// Independent uniform samples for one camera path.
 ///
-/// The stream is keyed by (seed, pixel, sample index); each call to [`Sampler::next_1d`] hashes
-/// the key with the next dimension number. There is no state besides that counter, so the
-/// same path always sees the same numbers, whichever thread traces it.
+/// The stream is keyed by (seed, pixel, sample index); each draw ([`Sampler::next_1d`], or
+/// [`Sampler::next_2d`] for a pair) hashes the key with the next dimension number. There is no
+/// state besides that counter, so the same path always sees the same numbers, whichever thread
+/// traces it.
 #[derive(Clone, Debug)]
 pub struct Sampler {
     key: u64,
