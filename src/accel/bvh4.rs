@@ -8,6 +8,10 @@
 //! (`watertight.rs`). Collapsing opens, while a node has fewer than four children, the child of
 //! largest surface area; subtrees of at most four triangles become one packet.
 //!
+//! Coherent rays (a pixel's camera rays) can be traced together: one traversal for the packet,
+//! whose box test bounds all its rays by interval arithmetic, with each ray's own box and
+//! triangle tests at the leaves (`intersect_many`).
+//!
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
 //! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches.
 
@@ -33,11 +37,20 @@ struct Node {
     children: [u32; 4],
 }
 
-/// The triangles of one leaf: `count` packets from `first`.
+/// The triangles of one leaf: `count` packets from `first`, and their bounding box (for the
+/// per-ray test of [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray).
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     first: u32,
     count: u32,
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl Leaf {
+    fn packets(&self) -> std::ops::Range<usize> {
+        self.first as usize..(self.first + self.count) as usize
+    }
 }
 
 /// The four-wide BVH; node 0 is the root.
@@ -58,23 +71,42 @@ struct RayBoxes {
     o_inv_d: [Vec4; 3],
 }
 
+/// A test of the four child boxes of a node: bit i of the mask set when the ray (or some ray of
+/// a packet) may meet child i's box within (0, t_max), and the entry distances (lower bounds,
+/// for a packet).
+trait BoxTest {
+    fn test(&self, node: &Node, t_max: f32) -> (u32, Vec4);
+}
+
+/// The reciprocal of a direction whose zero components are made tiny ones of the same sign, so
+/// that it stays finite and no 0 * inf makes a NaN in the slab test.
+#[inline(always)]
+fn safe_reciprocal(d: Vec3) -> Vec3A {
+    let d = Vec3A::from(d);
+    let tiny = Vec3A::splat(1e-20);
+    Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d).recip()
+}
+
+/// Per axis, 1 when the near plane is the max plane (a negative direction), else 0.
+#[inline(always)]
+fn near_is_max(inv_d: Vec3A) -> [usize; 3] {
+    let negative = inv_d.cmplt(Vec3A::ZERO).bitmask() as usize;
+    [negative & 1, (negative >> 1) & 1, negative >> 2]
+}
+
 impl RayBoxes {
     fn new(ray: &Ray) -> Self {
-        // A zero component becomes a tiny one of the same sign: its reciprocal stays finite,
-        // so that no 0 * inf makes a NaN in the slab test.
-        let d = Vec3A::from(ray.d);
-        let tiny = Vec3A::splat(1e-20);
-        let inv_d = Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d).recip();
+        let inv_d = safe_reciprocal(ray.d);
         let o_inv_d = Vec3A::from(ray.o) * inv_d;
-        let negative = inv_d.cmplt(Vec3A::ZERO).bitmask() as usize;
         RayBoxes {
-            near_is_max: [negative & 1, (negative >> 1) & 1, negative >> 2],
+            near_is_max: near_is_max(inv_d),
             inv_d: [Vec4::splat(inv_d.x), Vec4::splat(inv_d.y), Vec4::splat(inv_d.z)],
             o_inv_d: [Vec4::splat(o_inv_d.x), Vec4::splat(o_inv_d.y), Vec4::splat(o_inv_d.z)],
         }
     }
+}
 
-    /// Bit i set when the ray meets child i's box within (0, t_max); the entry distances.
+impl BoxTest for RayBoxes {
     #[inline(always)]
     fn test(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
         // Distance to the near (far: `max_side` 1) plane along `axis`; `& 1` keeps the index
@@ -87,6 +119,130 @@ impl RayBoxes {
         let t_far = slab(0, nx ^ 1).min(slab(1, ny ^ 1)).min(slab(2, nz ^ 1).min(Vec4::splat(t_max)));
         (t_near.cmple(t_far * ROBUST_FAR).bitmask(), t_near)
     }
+}
+
+/// The box test of a coherent packet of rays by interval arithmetic (Boulos et al. 2007,
+/// "Packet-based Whitted and Distribution Ray Tracing"): with the origins in a box and the
+/// reciprocal directions in per-axis intervals of one sign, a lower bound of every ray's entry
+/// distance and an upper bound of its exit distance, at about the cost of one ray's test.
+struct PacketBoxes {
+    near_is_max: [usize; 3],
+    inv_lo: [Vec4; 3],
+    inv_hi: [Vec4; 3],
+    /// Per axis, the end of the origins' interval that gives the smallest entry distance (the
+    /// largest origin for a positive direction), and the one that gives the largest exit.
+    o_near: [Vec4; 3],
+    o_far: [Vec4; 3],
+}
+
+impl PacketBoxes {
+    /// The bounds of `rays`, whose directions lie in one octant.
+    fn new(rays: &[CoherentRay]) -> Self {
+        let (mut inv_lo, mut inv_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        let (mut o_lo, mut o_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        for r in rays {
+            (inv_lo, inv_hi) = (inv_lo.min(r.inv_d), inv_hi.max(r.inv_d));
+            (o_lo, o_hi) = (o_lo.min(r.o), o_hi.max(r.o));
+        }
+        // One octant: a negative lower end means every reciprocal on that axis is negative.
+        let negative = inv_lo.cmplt(Vec3A::ZERO);
+        let (o_near, o_far) = (Vec3A::select(negative, o_lo, o_hi), Vec3A::select(negative, o_hi, o_lo));
+        let splat = |v: Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
+        PacketBoxes {
+            near_is_max: near_is_max(inv_lo),
+            inv_lo: splat(inv_lo),
+            inv_hi: splat(inv_hi),
+            o_near: splat(o_near),
+            o_far: splat(o_far),
+        }
+    }
+}
+
+impl BoxTest for PacketBoxes {
+    #[inline(always)]
+    fn test(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
+        // (plane - o) / d over the intervals: its smallest value for the near plane, its largest
+        // for the far one. The reciprocals have one sign, so the extremes are at their ends.
+        let near = |axis: usize, max_side: usize| {
+            let a = node.bounds[2 * axis + (max_side & 1)] - self.o_near[axis];
+            (a * self.inv_lo[axis]).min(a * self.inv_hi[axis])
+        };
+        let far = |axis: usize, max_side: usize| {
+            let b = node.bounds[2 * axis + (max_side & 1)] - self.o_far[axis];
+            (b * self.inv_lo[axis]).max(b * self.inv_hi[axis])
+        };
+        let [nx, ny, nz] = self.near_is_max;
+        let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
+        let t_far = far(0, nx ^ 1).min(far(1, ny ^ 1)).min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
+        (t_near.cmple(t_far * ROBUST_FAR).bitmask(), t_near)
+    }
+}
+
+/// One ray of a coherent packet: what its own tests need.
+struct CoherentRay {
+    o: Vec3A,
+    inv_d: Vec3A,
+    shear: RayShear,
+}
+
+impl CoherentRay {
+    fn new(ray: &Ray) -> Self {
+        CoherentRay { o: ray.o.into(), inv_d: safe_reciprocal(ray.d), shear: RayShear::new(ray) }
+    }
+
+    /// Whether the ray meets `leaf`'s box within (0, t_max) (robust as the node test).
+    #[inline(always)]
+    fn enters(&self, leaf: &Leaf, t_max: f32) -> bool {
+        let t0 = (leaf.lo - self.o) * self.inv_d;
+        let t1 = (leaf.hi - self.o) * self.inv_d;
+        let t_near = t0.min(t1).max_element().max(0.0);
+        let t_far = t0.max(t1).min_element().min(t_max);
+        t_near <= t_far * ROBUST_FAR
+    }
+}
+
+/// Most rays traced as one packet.
+const PACKET_SIZE: usize = 8;
+
+/// Rays whose directions are at least this close (cosine of the angle to the group's first ray)
+/// are traced as one packet. A pixel's camera rays are within a fraction of a degree; wider
+/// packets (bounces, shadow rays) measured slower than their rays traced alone.
+const COHERENT_COS: f32 = 0.999;
+
+/// The rays of `rays` (at most 32), grouped into packets that [`PacketBoxes`] bounds tightly:
+/// one octant, directions within `COHERENT_COS` of the group's first; each group a bit mask.
+fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
+    debug_assert!(rays.len() <= 32);
+    let mut by_octant = [0u32; 8];
+    for (i, r) in rays.iter().enumerate() {
+        by_octant[r.d.cmplt(Vec3::ZERO).bitmask() as usize] |= 1 << i;
+    }
+    let mut octant = 0;
+    std::iter::from_fn(move || {
+        while by_octant[octant] == 0 {
+            octant += 1;
+            if octant == 8 {
+                return None;
+            }
+        }
+        let remaining = by_octant[octant];
+        let first = remaining.trailing_zeros() as usize;
+        let mut group = 1u32 << first;
+        let d = rays[first].d;
+        // d_i . d >= COHERENT_COS |d_i| |d|, squared (in one octant, d_i . d is not negative).
+        let bound = COHERENT_COS * COHERENT_COS * d.length_squared();
+        let mut candidates = remaining & (remaining - 1);
+        while candidates != 0 && group.count_ones() < PACKET_SIZE as u32 {
+            let i = candidates.trailing_zeros() as usize;
+            candidates &= candidates - 1;
+            let dot = rays[i].d.dot(d);
+            if dot * dot >= bound * rays[i].d.length_squared() {
+                group |= 1 << i;
+            }
+        }
+        by_octant[octant] &= !group;
+        Some(group)
+    })
 }
 
 impl Bvh4 {
@@ -119,8 +275,8 @@ impl Bvh4 {
     pub(super) fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let shear = RayShear::new(ray);
         let mut closest: Option<Hit> = None;
-        self.traverse::<true>(ray, |packets, t_max| {
-            for p in packets {
+        self.traverse::<true>(&RayBoxes::new(ray), ray.t_max, |leaf, t_max| {
+            for p in leaf.packets() {
                 if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&self.packets[p], *t_max) {
                     closest = Some(Hit { triangle: self.packet_triangles[p][lane], t, b1, b2 });
                     *t_max = t;
@@ -135,21 +291,73 @@ impl Bvh4 {
     pub(super) fn occluded(&self, ray: &Ray) -> bool {
         let shear = RayShear::new(ray);
         let mut blocked = false;
-        self.traverse::<false>(ray, |mut packets, t_max| {
-            blocked = packets.any(|p| shear.occludes(&self.packets[p], *t_max));
+        self.traverse::<false>(&RayBoxes::new(ray), ray.t_max, |leaf, t_max| {
+            blocked = leaf.packets().any(|p| shear.occludes(&self.packets[p], *t_max));
             blocked
         });
         blocked
     }
 
-    /// Visit the leaves whose boxes the ray enters, calling `leaf(packets, t_max)`, which may
+    /// The closest hit of each ray of `rays` (at most 32), as [`Bvh4::intersect`] gives it but
+    /// for ties in distance; coherent rays are traced as packets.
+    pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        for group in coherent_groups(rays) {
+            if group.count_ones() == 1 {
+                let i = group.trailing_zeros() as usize;
+                hits[i] = self.intersect(&rays[i]);
+            } else {
+                self.intersect_coherent(rays, group, hits);
+            }
+        }
+    }
+
+    /// The closest hits of the rays of `group` (a bit mask into `rays`, at most `PACKET_SIZE`
+    /// set; directions in one octant), traversing once for all. Each ray meets the triangles of
+    /// the leaves it enters with the same test as alone.
+    fn intersect_coherent(&self, rays: &[Ray], group: u32, hits: &mut [Option<Hit>]) {
+        let mut index = [0usize; PACKET_SIZE];
+        let mut n = 0;
+        let mut rest = group;
+        while rest != 0 {
+            index[n] = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            n += 1;
+        }
+        // Unused slots repeat the first ray.
+        let packet = index.map(|i| CoherentRay::new(&rays[i]));
+        let mut t_max = index.map(|i| rays[i].t_max);
+        for &i in &index[..n] {
+            hits[i] = None;
+        }
+        let farthest = |t: &[f32]| t.iter().fold(0.0f32, |a, &b| a.max(b));
+        self.traverse::<true>(&PacketBoxes::new(&packet[..n]), farthest(&t_max[..n]), |leaf, packet_t_max| {
+            for (k, ray) in packet[..n].iter().enumerate() {
+                if !ray.enters(leaf, t_max[k]) {
+                    continue;
+                }
+                for p in leaf.packets() {
+                    if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&self.packets[p], t_max[k]) {
+                        hits[index[k]] = Some(Hit { triangle: self.packet_triangles[p][lane], t, b1, b2 });
+                        t_max[k] = t;
+                    }
+                }
+            }
+            *packet_t_max = farthest(&t_max[..n]);
+            false
+        });
+    }
+
+    /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(leaf, t_max)`, which may
     /// shorten `t_max` to a hit and returns true to end the traversal. With `CLOSEST`, children
     /// are visited nearest first and boxes beyond `t_max` are skipped; without, in any order (a
     /// shadow ray needs any hit, not the nearest).
     #[inline(always)]
-    fn traverse<const CLOSEST: bool>(&self, ray: &Ray, mut leaf: impl FnMut(std::ops::Range<usize>, &mut f32) -> bool) {
-        let boxes = RayBoxes::new(ray);
-        let mut t_max = ray.t_max;
+    fn traverse<const CLOSEST: bool>(
+        &self,
+        boxes: &impl BoxTest,
+        mut t_max: f32,
+        mut leaf: impl FnMut(&Leaf, &mut f32) -> bool,
+    ) {
         TRAVERSAL_STACK.with_borrow_mut(|stack| {
             stack.clear();
             let mut current = 0u32;
@@ -205,8 +413,7 @@ impl Bvh4 {
                         continue;
                     }
                 } else {
-                    let Leaf { first, count } = self.leaves[(current & !LEAF) as usize];
-                    if leaf(first as usize..(first + count) as usize, &mut t_max) {
+                    if leaf(&self.leaves[(current & !LEAF) as usize], &mut t_max) {
                         return;
                     }
                 }
@@ -323,12 +530,16 @@ impl Builder<'_> {
         }
         let out = &mut self.out;
         let first = out.packets.len() as u32;
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        for v in ids.iter().flat_map(|&i| self.triangles[i as usize]) {
+            (lo, hi) = (lo.min(v.into()), hi.max(v.into()));
+        }
         for chunk in ids.chunks(4) {
             let tris: Vec<[Vec3; 3]> = chunk.iter().map(|&i| self.triangles[i as usize]).collect();
             out.packets.push(TrianglePacket::new(&tris));
             out.packet_triangles.push(std::array::from_fn(|lane| *chunk.get(lane).unwrap_or(&chunk[0])));
         }
-        out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first });
+        out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first, lo, hi });
         LEAF | (out.leaves.len() as u32 - 1)
     }
 }

@@ -117,6 +117,19 @@ impl Accel {
         }
     }
 
+    /// The closest hit of each of `rays` into `hits` (of the same length), as [`Accel::intersect`]
+    /// gives it but for ties in distance. Rays of nearly one direction (a pixel's camera rays)
+    /// are traced together as a packet, for less than each alone.
+    pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit per ray");
+        for (rays, hits) in rays.chunks(32).zip(hits.chunks_mut(32)) {
+            match &self.backend {
+                Backend::Bvh4(bvh) => bvh.intersect_many(rays, hits),
+                _ => rays.iter().zip(hits).for_each(|(r, h)| *h = self.intersect(r)),
+            }
+        }
+    }
+
     /// True when any triangle lies on the ray with `0 < t < ray.t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
@@ -240,6 +253,43 @@ mod tests {
                 assert_eq!(expected.map(|e| e.1), accel.intersect(&ray).map(|h| h.triangle), "{kind:?}: ray {ray:?}");
                 assert_eq!(expected.is_some(), accel.occluded(&ray));
             }
+        }
+    }
+
+    #[test]
+    fn batched_closest_hits_match_single_ray_queries() {
+        // Batches of up to 32 rays: bundles around a few directions (traced as packets, some
+        // from spread origins, some with t_max cut short), and stray rays among them.
+        let mut rng = Lcg(19);
+        let tris = random_scene(&mut rng, 2000);
+        for (kind, accel) in each_kind(&tris) {
+            let mut hits_seen = 0;
+            for batch in 0..600 {
+                let n = 1 + batch % 32;
+                let bundles: Vec<(Vec3, Vec3)> = (0..1 + batch % 3).map(|_| (rng.vec(14.0), rng.vec(2.0))).collect();
+                let spread = [0.0, 0.001, 0.02][batch % 3];
+                let rays: Vec<Ray> = (0..n)
+                    .map(|i| {
+                        if rng.next() < 0.15 {
+                            return Ray::new(rng.vec(14.0), rng.vec(2.0));
+                        }
+                        let (o, d) = bundles[i % bundles.len()];
+                        let mut ray = Ray::new(o + rng.vec(spread), (d - o).normalize() + rng.vec(spread));
+                        if rng.next() < 0.3 {
+                            ray.t_max = rng.next() * 20.0;
+                        }
+                        ray
+                    })
+                    .collect();
+                // Stale answers in the output, which every query must overwrite.
+                let mut hits = vec![Some(Hit { t: 1.0, triangle: 0, b1: 0.0, b2: 0.0 }); n];
+                accel.intersect_many(&rays, &mut hits);
+                for (i, ray) in rays.iter().enumerate() {
+                    assert_eq!(hits[i], accel.intersect(ray), "{kind:?}: ray {i} of batch {batch}: {ray:?}");
+                    hits_seen += hits[i].is_some() as u32;
+                }
+            }
+            assert!(hits_seen > 2000, "{kind:?}: only {hits_seen} hits");
         }
     }
 

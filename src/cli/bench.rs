@@ -135,6 +135,16 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
             Some(Ray::new(offset_ray_origin(p, n, d), d))
         })
         .collect();
+    // A pixel's camera rays: 8 jittered rays through each of 512 x 512 pixels, traced one by one
+    // and as the batches the renderer hands `intersect_many`.
+    let pixel_samples: Vec<Ray> = (0..512 * 512 * 8)
+        .map(|i| {
+            let pixel = i / 8;
+            let jitter = Sampler::new(2, pixel as u64, i as u32 % 8).next_2d();
+            let film = glam::Vec2::new((pixel % 512) as f32 * 2.0, (pixel / 512) as f32 * 2.0) + jitter;
+            camera.generate_ray(film).0
+        })
+        .collect();
     for (kind, accel, build_seconds) in &builds {
         println!("accel      {kind:?} build, {} triangles: {build_seconds:.3} s", tris.len());
         let closest_serial = |rays: &[Ray]| rays.iter().filter(|r| accel.intersect(r).is_some()).count();
@@ -149,6 +159,22 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
                 100.0 * hits as f64 / rays.len() as f64
             );
         }
+        let batched = |rays: &[Ray]| {
+            let mut hits = [None; 8];
+            rays.chunks(8)
+                .map(|batch| {
+                    accel.intersect_many(batch, &mut hits[..batch.len()]);
+                    hits.iter().filter(|h| h.is_some()).count()
+                })
+                .sum()
+        };
+        let (alone, _) = rays_per_second(runs, &pixel_samples, closest_serial);
+        let (together, _) = rays_per_second(runs, &pixel_samples, batched);
+        println!(
+            "rays       {kind:?} 8 per pixel {:>8} rays: {alone:6.2} Mrays/s one by one, {together:6.2} in batches ({:.2}x), 1 thread",
+            pixel_samples.len(),
+            together / alone
+        );
     }
     Ok(())
 }

@@ -17,6 +17,9 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Side of the square tiles work is split into.
 const TILE: u32 = 16;
 
+/// A pixel's camera rays are traced this many at a time, as a packet.
+const PACKET: usize = 8;
+
 /// A rectangle of pixels `[x0, x1) x [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Crop {
@@ -77,20 +80,33 @@ pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn F
     tiles.par_iter().for_each(|&(tx, ty)| {
         let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
         let mut aov_buf = vec![0.0f32; stride];
+        let mut primary = [None; PACKET];
         for fy in ty * TILE..((ty + 1) * TILE).min(h) {
             for fx in tx * TILE..((tx + 1) * TILE).min(w) {
                 let (px, py) = (crop.x0 + fx, crop.y0 + fy);
                 let pixel_index = py as u64 * s.width as u64 + px as u64;
                 let mut sum = PixelSum::new(stride);
                 let key = PixelKey::new(s.seed, pixel_index);
-                for i in 0..s.spp {
+                let camera_sample = |i: u32| {
                     let mut sampler = key.sampler(i);
                     let film_pos = Vec2::new(px as f32, py as f32) + sampler.next_2d();
                     let (ray, diff) = scene.camera.generate_ray(film_pos);
-                    let mut first_hit = None;
-                    let l = tracer.trace(ray, &diff, &mut sampler, &mut first_hit);
-                    aov_values(aovs, &first_hit, &mut aov_buf);
-                    sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), &aov_buf);
+                    (ray, diff, sampler)
+                };
+                // The camera rays of up to PACKET samples at a time are traced together, as a
+                // packet (`Accel::intersect_many`); then each sample's path on its own.
+                for first in (0..s.spp).step_by(PACKET) {
+                    let count = (s.spp - first).min(PACKET as u32) as usize;
+                    // Slots past `count` repeat the last sample, and are not traced.
+                    let batch: [_; PACKET] = std::array::from_fn(|k| camera_sample(first + k.min(count - 1) as u32));
+                    let rays = batch.each_ref().map(|b| b.0);
+                    scene.accel.intersect_many(&rays[..count], &mut primary[..count]);
+                    for ((ray, diff, mut sampler), hit) in batch.into_iter().zip(primary).take(count) {
+                        let mut first_hit = None;
+                        let l = tracer.trace(ray, hit, &diff, &mut sampler, &mut first_hit);
+                        aov_values(aovs, &first_hit, &mut aov_buf);
+                        sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), &aov_buf);
+                    }
                 }
                 pixels.push((fx as usize, fy as usize, sum));
             }

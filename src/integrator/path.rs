@@ -5,6 +5,7 @@
 //! shows only emitters seen directly and 2 adds direct lighting. Russian roulette starts once
 //! `rr_depth` segments are traced, continuing with probability min(max(throughput) eta^2, 0.95).
 
+use crate::accel::Hit;
 use crate::color::Rgb;
 use crate::geometry::{Frame, Ray, RayDifferential};
 use crate::sampling::{Sampler, power_heuristic};
@@ -67,11 +68,13 @@ impl<'a> PathTracer<'a> {
         }
     }
 
-    /// Radiance arriving along the camera ray `ray` (with differentials `diff`); `first_hit` is
-    /// filled where the tracer records first hits and the ray hits something.
+    /// Radiance arriving along the camera ray `ray` (with differentials `diff`), whose closest
+    /// hit is `primary` (the renderer traces a pixel's camera rays together, as a packet);
+    /// `first_hit` is filled where the tracer records first hits and the ray hits something.
     pub fn trace(
         &self,
         mut ray: Ray,
+        primary: Option<Hit>,
         diff: &RayDifferential,
         sampler: &mut Sampler,
         first_hit: &mut Option<FirstHit>,
@@ -85,7 +88,8 @@ impl<'a> PathTracer<'a> {
         let mut prev = PreviousVertex { p: ray.o, pdf: 1.0, delta: true };
         let mut depth = 0u32;
         loop {
-            let Some(mut si) = scene.intersect(&ray) else {
+            let hit = if depth == 0 { primary } else { scene.accel.intersect(&ray) };
+            let Some(hit) = hit else {
                 if let Some(env) = &lights.environment {
                     let d = ray.d.normalize();
                     let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, lights.environment_pdf(d)) };
@@ -93,6 +97,7 @@ impl<'a> PathTracer<'a> {
                 }
                 break;
             };
+            let mut si = scene.interaction(&ray, &hit);
             let shape = scene.shape_of(si.triangle);
 
             if let Some(light) = shape.light {

@@ -21,7 +21,7 @@ pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Opti
     }
 }
 
-use crate::accel::Accel;
+use crate::accel::{Accel, Hit};
 use crate::camera::PerspectiveCamera;
 use crate::geometry::{Bounds, Ray, SurfaceInteraction, TriangleMesh, TriangleVertices};
 use crate::light::Lights;
@@ -161,14 +161,18 @@ pub struct Scene {
 impl Scene {
     /// The closest surface along `ray`.
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let hit = self.accel.intersect(ray)?;
-        let tri = self.geometry.triangle_vertices(hit.triangle as usize);
-        Some(SurfaceInteraction::from_triangle(&tri, hit.b1, hit.b2, hit.t, ray, hit.triangle))
+        Some(self.interaction(ray, &self.accel.intersect(ray)?))
     }
 
     /// True when something blocks `ray` before its `t_max`.
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.accel.occluded(ray)
+    }
+
+    /// The surface that `ray` meets at `hit` (an answer of [`Scene::accel`] for `ray`).
+    pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
+        let tri = self.geometry.triangle_vertices(hit.triangle as usize);
+        SurfaceInteraction::from_triangle(&tri, hit.b1, hit.b2, hit.t, ray, hit.triangle)
     }
 
     /// The shape a triangle belongs to.
