@@ -231,10 +231,10 @@ fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
         let d = rays[first].d;
         // d_i . d >= COHERENT_COS |d_i| |d|, squared (in one octant, d_i . d is not negative).
         let bound = COHERENT_COS * COHERENT_COS * d.length_squared();
-        let mut candidates = remaining & (remaining - 1);
-        while candidates != 0 && group.count_ones() < PACKET_SIZE as u32 {
-            let i = candidates.trailing_zeros() as usize;
-            candidates &= candidates - 1;
+        for i in set_bits(remaining & (remaining - 1)) {
+            if group.count_ones() == PACKET_SIZE as u32 {
+                break;
+            }
             let dot = rays[i].d.dot(d);
             if dot * dot >= bound * rays[i].d.length_squared() {
                 group |= 1 << i;
@@ -315,15 +315,12 @@ impl Bvh4 {
     /// set; directions in one octant), traversing once for all. Each ray meets the triangles of
     /// the leaves it enters with the same test as alone.
     fn intersect_coherent(&self, rays: &[Ray], group: u32, hits: &mut [Option<Hit>]) {
-        let mut index = [0usize; PACKET_SIZE];
-        let mut n = 0;
-        let mut rest = group;
-        while rest != 0 {
-            index[n] = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            n += 1;
-        }
         // Unused slots repeat the first ray.
+        let mut index = [group.trailing_zeros() as usize; PACKET_SIZE];
+        let n = group.count_ones() as usize;
+        for (slot, i) in index.iter_mut().zip(set_bits(group)) {
+            *slot = i;
+        }
         let packet = index.map(|i| CoherentRay::new(&rays[i]));
         let mut t_max = index.map(|i| rays[i].t_max);
         for &i in &index[..n] {
@@ -430,6 +427,16 @@ impl Bvh4 {
             }
         })
     }
+}
+
+/// The indices of the bits set in `mask`, lowest first.
+#[inline(always)]
+fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        let i = (mask != 0).then_some(mask.trailing_zeros() as usize)?;
+        mask &= mask - 1;
+        Some(i)
+    })
 }
 
 thread_local! {

@@ -164,7 +164,7 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
             rays.chunks(8)
                 .map(|batch| {
                     accel.intersect_many(batch, &mut hits[..batch.len()]);
-                    hits.iter().filter(|h| h.is_some()).count()
+                    hits[..batch.len()].iter().filter(|h| h.is_some()).count()
                 })
                 .sum()
         };
