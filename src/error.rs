@@ -57,6 +57,15 @@ pub enum Error {
         /// What went wrong with it.
         source: Box<Error>,
     },
+    /// A third-party parser failed in a way it should have reported as an error (a panic,
+    /// caught by [`guard_parser`]): the file is malformed in a way tessera does not yet check.
+    #[error("{}: malformed file (the parser failed: {msg})", path.display())]
+    Parser {
+        /// The file being parsed.
+        path: PathBuf,
+        /// The parser's panic message and where it happened.
+        msg: String,
+    },
     /// A parameter is out of its valid range (a resolution, a sample count, a roughness...).
     #[error("{what}: {msg}")]
     Param {
@@ -109,4 +118,43 @@ impl Error {
     pub fn param(what: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::Param { what: what.into(), msg: msg.into() }
     }
+}
+
+thread_local! {
+    /// Set while [`guard_parser`] runs a parser on this thread: its panics are caught, so the
+    /// panic hook keeps their message for the error instead of printing it.
+    static GUARDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    static CAUGHT: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Run a third-party parser (glTF, OBJ, image decoders), turning a panic inside it into an
+/// error naming `path`. This is the last line of defence only: tessera validates what it
+/// hands to these parsers so that they do not panic; a panic that gets here is a gap in that
+/// validation, reported as an error rather than a crash.
+pub fn guard_parser<T>(path: &Path, parse: impl FnOnce() -> Result<T>) -> Result<T> {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if GUARDED.get() {
+                let message = info
+                    .payload()
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| info.payload().downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "(no message)".into());
+                let at = info.location().map(|l| format!(" at {}:{}", l.file(), l.line())).unwrap_or_default();
+                CAUGHT.set(Some(format!("{message}{at}")));
+            } else {
+                previous(info);
+            }
+        }));
+    });
+    let outer = GUARDED.replace(true);
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse));
+    GUARDED.set(outer);
+    result.unwrap_or_else(|_| {
+        let message = CAUGHT.take().unwrap_or_default();
+        Err(Error::Parser { path: path.to_path_buf(), msg: message })
+    })
 }

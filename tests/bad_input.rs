@@ -142,7 +142,7 @@ fn absurd_parameters_are_rejected() {
         &[],
         &["unknown IOR name"],
     );
-    error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = -1\n"), &[], &["negative radiance"]);
+    error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = -1\n"), &[], &["emission", "outside [0, 1e15]"]);
     error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\ntransform = [{{ scale = 0 }}]\n"), &[], &["singular"]);
 }
 

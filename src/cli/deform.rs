@@ -11,6 +11,7 @@ use tessera::deform::{DeformationMaps, Orientation, channel_std, deformation_map
 use tessera::error::{Error, Result};
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
+use tessera::limits;
 use tessera::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, Synthesis, Tiling};
 use tessera::texture::{Filter, ImageTexture, MipMap, Texture, TilingBlending};
 
@@ -20,11 +21,11 @@ pub struct MeshArgs {
     /// The mesh with texture coordinates: OBJ, or glTF 2.0 (.gltf, .glb; all its triangle
     /// primitives in world space).
     mesh: PathBuf,
-    /// Vertices per side of the smoothing grid over the UV square (Eq. 7).
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    /// Vertices per side of the smoothing grid over the UV square (Eq. 7; at most 4096).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_DEFORM_GRID as i64))]
     grid: u32,
-    /// Texels per side of the F map and the cut map.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    /// Texels per side of the F map and the cut map (at most 4096).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_DEFORM_RES as i64))]
     res: u32,
     /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected
     /// on the surface), `parallels:X,Y,Z` (circles around an axis through the origin) or

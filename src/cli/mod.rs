@@ -12,6 +12,7 @@ use std::time::Instant;
 use tessera::error::{Error, Result};
 use tessera::image::{Aov, Bitmap, write_image};
 use tessera::integrator::{Crop, render};
+use tessera::limits;
 use tessera::scene::{Scene, SceneOverrides, load_scene};
 use tessera::texture::{BakeFootprint, bake};
 
@@ -35,8 +36,8 @@ enum Command {
         /// Samples per pixel (replaces the scene's).
         #[arg(long)]
         spp: Option<u32>,
-        /// Worker threads (default: all cores). The image does not depend on it.
-        #[arg(long)]
+        /// Worker threads (default: all cores; at most 1024). The image does not depend on it.
+        #[arg(long, value_parser = thread_count)]
         threads: Option<usize>,
         /// Sampler seed (replaces the scene's).
         #[arg(long)]
@@ -71,13 +72,13 @@ enum Command {
         #[arg(long, requires = "spp")]
         variance: Option<PathBuf>,
         /// Samples per pixel of the test image (for the Z-test).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         spp: Option<u32>,
         /// Fail when relMSE exceeds this.
-        #[arg(long)]
+        #[arg(long, value_parser = non_negative)]
         max_relmse: Option<f64>,
         /// Fail when the mean FLIP exceeds this.
-        #[arg(long)]
+        #[arg(long, value_parser = non_negative)]
         max_flip: Option<f64>,
         /// Write an error image (EXR): |test - reference| as RGB, the FLIP map, and with the Z-test
         /// the smallest p-value of each pixel.
@@ -94,8 +95,8 @@ enum Command {
         /// Samples per pixel written into the exported scene (default: the scene's).
         #[arg(long)]
         spp: Option<u32>,
-        /// Resolution at which procedural textures are baked over the UV square.
-        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=16384))]
+        /// Resolution at which procedural textures are baked over the UV square (at most 8192).
+        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_BAKE_RES as i64))]
         bake_res: u32,
     },
     /// Evaluate one texture of a scene over the UV square [0, 1]^2, with no light transport
@@ -106,8 +107,8 @@ enum Command {
         /// Name of the texture (`[textures.NAME]`).
         #[arg(long)]
         texture: String,
-        /// Image width and height in texels.
-        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=16384))]
+        /// Image width and height in texels (at most 8192).
+        #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_BAKE_RES as i64))]
         res: u32,
         /// Output image, .exr or .png.
         #[arg(short, long)]
@@ -237,6 +238,22 @@ pub fn run() -> Result<ExitCode> {
     }
 }
 
+/// A worker thread count: 0 (all cores) to [`limits::MAX_THREADS`].
+fn thread_count(text: &str) -> std::result::Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if n <= limits::MAX_THREADS => Ok(n),
+        _ => Err(format!("'{text}' is not a thread count from 0 (all cores) to {}", limits::MAX_THREADS)),
+    }
+}
+
+/// A command-line number that must be finite and at least 0 (`nan` would pass every test).
+fn non_negative(text: &str) -> std::result::Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("'{text}' is not a finite number >= 0")),
+    }
+}
+
 fn default_output(scene: &Path) -> PathBuf {
     let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "render".into());
     PathBuf::from(format!("{stem}.exr"))
@@ -329,21 +346,35 @@ fn diff(
     max_flip: Option<f64>,
     output: Option<&Path>,
 ) -> Result<ExitCode> {
-    use tessera::image::{ColorSpace, compare, read_bitmap};
+    use tessera::image::{ColorSpace, compare, read_bitmap, read_bitmap_raw};
     if variance.is_none() && max_relmse.is_none() && max_flip.is_none() {
         return Err(Error::param(
             "diff",
             "give a criterion: --variance with --spp (Z-test), --max-relmse or --max-flip",
         ));
     }
+    // NaN or infinity in the test image is a failure, never a value to compare (read as 0 it
+    // would pass against black); in the reference or its variance it is an error.
+    let t = read_bitmap_raw(test, ColorSpace::Linear)?;
+    let invalid = t.non_finite_count();
     let t = read_bitmap(test, ColorSpace::Linear)?;
-    let r = read_bitmap(reference, ColorSpace::Linear)?;
+    let finite = |path: &Path| -> Result<tessera::image::Bitmap> {
+        let image = read_bitmap_raw(path, ColorSpace::Linear)?;
+        match image.non_finite_count() {
+            0 => read_bitmap(path, ColorSpace::Linear),
+            n => Err(Error::image(path, format!("{n} values are NaN or infinite: not usable as a reference"))),
+        }
+    };
+    let r = finite(reference)?;
     let m = compare::image_metrics(&t, &r)?;
     println!("relmse     {:.6e}", m.relmse);
     println!("mae        {:.6e}", m.mae);
     println!("flip       {:.6}  (mean LDR-FLIP)", m.mean_flip);
     println!("mean       test {:?}, reference {:?}", m.mean_test.map(|v| v as f32), m.mean_reference.map(|v| v as f32));
     let mut failures = Vec::new();
+    if invalid > 0 {
+        failures.push(format!("{invalid} values of the test image are NaN or infinite"));
+    }
     if let Some(limit) = max_relmse.filter(|l| m.relmse > *l) {
         failures.push(format!("relMSE {:.4e} > {limit:e}", m.relmse));
     }
@@ -352,7 +383,7 @@ fn diff(
     }
     let z = match variance {
         Some((path, spp)) => {
-            let v = read_bitmap(path, ColorSpace::Linear)?;
+            let v = finite(path)?;
             let z = compare::z_test(&t, spp, &r, &v)?;
             println!(
                 "z-test     {:.4}% of pixels accepted (need {}%), alpha {:.3e}, min p {:.3e}",

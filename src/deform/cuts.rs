@@ -8,7 +8,7 @@
 //! tiling-and-blending lookup can give every tile centred in the cell the same centre and shift
 //! on both sides (Eq. 8).
 
-use super::nearest::{NONE, distance2_to_segment, propagate_nearest};
+use super::nearest::{NONE, clamped_pieces, distance2_to_segment, propagate_nearest};
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::math::largest_singular_value;
@@ -274,17 +274,22 @@ impl Cuts {
         let last = (res - 1) as f32;
         for id in 0..2 * self.edges.len() as u32 {
             let [a, b] = segment(id);
-            let steps = (a.distance(b) * res as f32 * 2.0).min(1e6).ceil() as usize + 1;
-            for s in 0..=steps {
-                let p = (a.lerp(b, s as f32 / steps as f32) * res as f32).floor();
-                if !p.is_finite() {
-                    continue;
-                }
-                let (i, j) = (p.x.clamp(0.0, last) as usize, p.y.clamp(0.0, last) as usize);
-                let d = distance2_to_segment(point(i, j), a, b);
-                if d < best[j * res + i] {
-                    best[j * res + i] = d;
-                    owner[j * res + i] = id;
+            // Step along the copy as the map sees it, clamped to the square: a few steps per
+            // texel of that path, however long the copy is in UV (UVs far outside the square
+            // would otherwise take millions of steps per edge).
+            for [p0, q0] in clamped_pieces(a, b) {
+                let steps = (p0.distance(q0) * res as f32 * 2.0).ceil() as usize + 1;
+                for s in 0..=steps {
+                    let p = (p0.lerp(q0, s as f32 / steps as f32) * res as f32).floor();
+                    if !p.is_finite() {
+                        continue;
+                    }
+                    let (i, j) = (p.x.clamp(0.0, last) as usize, p.y.clamp(0.0, last) as usize);
+                    let d = distance2_to_segment(point(i, j), a, b);
+                    if d < best[j * res + i] {
+                        best[j * res + i] = d;
+                        owner[j * res + i] = id;
+                    }
                 }
             }
         }

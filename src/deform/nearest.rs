@@ -46,3 +46,18 @@ pub fn distance2_to_segment(p: glam::Vec2, a: glam::Vec2, b: glam::Vec2) -> f32 
     let s = ((p - a).dot(ab) / ab.length_squared().max(1e-30)).clamp(0.0, 1.0);
     (a + ab * s).distance_squared(p)
 }
+/// The segment a-b clamped to the unit square, as at most five straight pieces: clamping is
+/// linear between the points where the segment crosses the lines u = 0, u = 1, v = 0, v = 1.
+/// Pieces of a non-finite segment are not finite either; callers skip such points.
+pub(super) fn clamped_pieces(a: glam::Vec2, b: glam::Vec2) -> Vec<[glam::Vec2; 2]> {
+    let d = b - a;
+    let mut ts = vec![0.0f32, 1.0];
+    for axis in 0..2 {
+        if d[axis] != 0.0 {
+            ts.extend([0.0, 1.0].map(|edge| (edge - a[axis]) / d[axis]).into_iter().filter(|t| *t > 0.0 && *t < 1.0));
+        }
+    }
+    ts.sort_by(f32::total_cmp);
+    let clamp = |t: f32| (a + d * t).clamp(glam::Vec2::ZERO, glam::Vec2::ONE);
+    ts.windows(2).map(|w| [clamp(w[0]), clamp(w[1])]).collect()
+}

@@ -141,14 +141,17 @@ impl TriangleMesh {
         }
     }
 
-    /// Check the mesh for unusable data and drop degenerate triangles.
-    ///
-    /// Errors (returned as a message for the caller to attach the file name to): non-finite
-    /// positions, normals or texture coordinates, indices out of range, attribute arrays whose
-    /// length differs from the vertex count, and a mesh with no triangle left.
-    /// Zero-area triangles are removed and counted: they cannot be hit and have no normal.
-    pub fn validate(&mut self) -> Result<MeshCleanup, String> {
+    /// Check the mesh for data no consumer can use, as every loader does before handing a
+    /// mesh on. Errors (returned as a message for the caller to attach the file name to):
+    /// non-finite positions, normals or texture coordinates, indices out of range, attribute
+    /// arrays whose length differs from the vertex count, more triangles than
+    /// [`crate::limits::MAX_TRIANGLES`].
+    pub fn check(&self) -> Result<(), String> {
         let n = self.positions.len();
+        if self.indices.len() as u64 > crate::limits::MAX_TRIANGLES {
+            let limit = crate::limits::MAX_TRIANGLES;
+            return Err(crate::limits::exceeded("the triangle count", self.indices.len(), limit));
+        }
         if let Some(i) = self.positions.iter().position(|p| !p.is_finite()) {
             return Err(format!("vertex {i} has a non-finite position {}", self.positions[i]));
         }
@@ -173,6 +176,14 @@ impl TriangleMesh {
                 return Err(format!("triangle {i} refers to vertex {bad}, but there are only {n} vertices"));
             }
         }
+        Ok(())
+    }
+
+    /// [`TriangleMesh::check`] the mesh and drop its degenerate triangles, for rendering: an
+    /// error also for a mesh with no triangle left. Zero-area triangles are removed and
+    /// counted: they cannot be hit and have no normal.
+    pub fn validate(&mut self) -> Result<MeshCleanup, String> {
+        self.check()?;
         let before = self.indices.len();
         let positions = &self.positions;
         self.indices.retain(|&[a, b, c]| {

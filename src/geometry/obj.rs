@@ -2,20 +2,21 @@
 //! (OBJ's bottom-left origin is tessera's convention).
 
 use super::TriangleMesh;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, guard_parser};
+use crate::files::read_bounded;
+use crate::limits;
 use glam::{Vec2, Vec3};
 use std::path::Path;
 
 /// Load every object of an OBJ file into one mesh. Materials (`.mtl`) are ignored: the scene
 /// file assigns them. Attributes present on only some vertices are an error.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh> {
+    let bytes = read_bounded(path, limits::MAX_MESH_FILE_BYTES, "a mesh file")?;
     let options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
-    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| match e {
-        tobj::LoadError::OpenFileFailed => match std::fs::metadata(path) {
-            Err(io) => Error::io(path, io),
-            Ok(_) => Error::mesh(path, "cannot open the file"),
-        },
-        other => Error::mesh(path, format!("malformed OBJ: {other}")),
+    let (models, _materials) = guard_parser(path, || {
+        // Materials (`mtllib`) are not read: the scene file assigns them.
+        tobj::load_obj_buf(&mut &bytes[..], &options, |_| Err(tobj::LoadError::OpenFileFailed))
+            .map_err(|e| Error::mesh(path, format!("malformed OBJ: {e}")))
     })?;
     let (mut positions, mut normals, mut uvs, mut indices) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for model in &models {
@@ -23,12 +24,23 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh> {
         let base = positions.len() as u32;
         let count = m.positions.len() / 3;
         positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
-        if m.normals.len() == m.positions.len() {
-            normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        // tobj gives an attribute to no vertex of the object or to every one; anything in
+        // between means that some faces lack it (`f 1/1 2/2 3/3` beside `f 1 2 3`).
+        let partial = |have: usize, per_vertex: usize, what: &str| {
+            (have != 0 && have != per_vertex * count).then(|| {
+                Error::mesh(
+                    path,
+                    format!("object '{}': some faces have {what} and others do not; give all or none", model.name),
+                )
+            })
+        };
+        if let Some(e) =
+            partial(m.normals.len(), 3, "normals (vn)").or(partial(m.texcoords.len(), 2, "texture coordinates (vt)"))
+        {
+            return Err(e);
         }
-        if m.texcoords.len() / 2 == count {
-            uvs.extend(m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
-        }
+        normals.extend(m.normals.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        uvs.extend(m.texcoords.chunks_exact(2).map(|c| Vec2::new(c[0], c[1])));
         if m.indices.len() % 3 != 0 {
             return Err(Error::mesh(path, format!("object '{}' has an incomplete triangle", model.name)));
         }

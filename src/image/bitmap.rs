@@ -59,6 +59,11 @@ impl Bitmap {
         &mut self.data[i..i + self.channels]
     }
 
+    /// Number of NaN or infinite values.
+    pub fn non_finite_count(&self) -> usize {
+        self.data.iter().filter(|v| !v.is_finite()).count()
+    }
+
     /// Mean of each channel.
     pub fn channel_means(&self) -> Vec<f64> {
         let mut sums = vec![0.0f64; self.channels];

@@ -66,8 +66,10 @@ impl PixelSum {
         }
         self.count += 1;
         self.invalid += u32::from(invalid);
+        // AOVs come from textures and geometry, which extreme input can drive to NaN; like
+        // radiance, a non-finite value counts as zero rather than poisoning the pixel.
         for (s, v) in self.aov.iter_mut().zip(aov_values) {
-            *s += *v as f64;
+            *s += if v.is_finite() { *v as f64 } else { 0.0 };
         }
     }
 }
@@ -132,7 +134,8 @@ impl Film {
         out
     }
 
-    /// Per-pixel variance of one sample (unbiased, N - 1 in the denominator; 0 with one sample).
+    /// Per-pixel variance of one sample (unbiased, N - 1 in the denominator; 0 with one sample;
+    /// at most `f32::MAX`).
     pub fn variance(&self) -> Bitmap {
         let mut out = Bitmap::new(self.width, self.height, 3);
         for (px, p) in out.data.chunks_exact_mut(3).zip(&self.pixels) {
@@ -142,7 +145,8 @@ impl Film {
             }
             for ((v, sum), sum_sq) in px.iter_mut().zip(p.sum).zip(p.sum_sq) {
                 let mean = sum / n;
-                *v = ((sum_sq / n - mean * mean).max(0.0) * n / (n - 1.0)) as f32;
+                // Squares of finite f32 samples can exceed f32's range: saturate, never inf.
+                *v = ((sum_sq / n - mean * mean).max(0.0) * n / (n - 1.0)).min(f32::MAX as f64) as f32;
             }
         }
         out

@@ -4,8 +4,11 @@
 
 use super::{Bitmap, ColorSpace};
 use crate::color::{linear_to_srgb, srgb_to_linear, srgb_u8_table};
+use crate::error::guard_parser;
 use crate::error::{Error, Result};
-use std::path::{Path, PathBuf};
+use crate::files::{read_bounded, write_atomically};
+use crate::limits;
+use std::path::Path;
 
 /// Output file formats, chosen by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,12 +55,26 @@ pub fn read_bitmap_raw(path: &Path, space: ColorSpace) -> Result<Bitmap> {
 }
 
 fn read_with_image_crate(path: &Path, space: ColorSpace) -> Result<Bitmap> {
+    let bytes = read_bounded(path, limits::MAX_IMAGE_FILE_BYTES, "an image file")?;
+    decode_image(&bytes, path, space)
+}
+
+/// Decode an encoded image (PNG, JPEG, Radiance HDR, by its content) held in memory; `path`
+/// names it in errors (the file it came from). Sizes are checked against [`crate::limits`]
+/// before the pixels are allocated. Channels as in [`read_bitmap_raw`].
+pub fn decode_image(bytes: &[u8], path: &Path, space: ColorSpace) -> Result<Bitmap> {
     use ::image::DynamicImage;
-    let reader = ::image::ImageReader::open(path)
-        .map_err(|e| Error::io(path, e))?
-        .with_guessed_format()
-        .map_err(|e| Error::io(path, e))?;
-    let decoded = reader.decode().map_err(|e| Error::image(path, format!("cannot decode: {e}")))?;
+    let mut reader =
+        ::image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| Error::io(path, e))?;
+    let mut image_limits = ::image::Limits::default();
+    image_limits.max_image_width = Some(limits::MAX_IMAGE_SIDE);
+    image_limits.max_image_height = Some(limits::MAX_IMAGE_SIDE);
+    // The decoder's own buffers: 16-bit RGBA at the largest pixel count.
+    image_limits.max_alloc = Some(limits::MAX_IMAGE_PIXELS * 8);
+    reader.limits(image_limits);
+    let decoded =
+        guard_parser(path, || reader.decode().map_err(|e| Error::image(path, format!("cannot decode: {e}"))))?;
+    check_image_size(path, decoded.width() as u64, decoded.height() as u64, decoded.color().channel_count() as u64)?;
     let (w, h) = (decoded.width() as usize, decoded.height() as usize);
     let srgb = space == ColorSpace::Srgb;
     // Integer formats: (channels, has alpha, values scaled to [0, 1]).
@@ -101,19 +118,57 @@ pub(crate) fn srgb_decode_colors(data: &mut [f32], channels: usize) {
     }
 }
 
+/// An error if an image of `width` x `height` pixels of `channels` values is over the limits.
+fn check_image_size(path: &Path, width: u64, height: u64, channels: u64) -> Result<()> {
+    let side = width.max(height);
+    if side > limits::MAX_IMAGE_SIDE as u64 {
+        return Err(Error::image(path, limits::exceeded("the image's side", side, limits::MAX_IMAGE_SIDE)));
+    }
+    if width * height > limits::MAX_IMAGE_PIXELS {
+        let size = format!("{width}x{height} pixels");
+        return Err(Error::image(
+            path,
+            limits::exceeded("the image", size, format!("{} pixels", limits::MAX_IMAGE_PIXELS)),
+        ));
+    }
+    if width * height * channels > limits::MAX_IMAGE_VALUES {
+        let size = format!("{width}x{height} pixels of {channels} channels");
+        return Err(Error::image(
+            path,
+            limits::exceeded("the image", size, format!("{} values", limits::MAX_IMAGE_VALUES)),
+        ));
+    }
+    Ok(())
+}
+
+/// Check an OpenEXR file's headers before its pixels are allocated: the exr crate allocates
+/// what the data window claims.
+fn check_exr_header(path: &Path, bytes: &[u8]) -> Result<()> {
+    let meta = guard_parser(path, || {
+        exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+            .map_err(|e| Error::image(path, format!("cannot read OpenEXR: {e}")))
+    })?;
+    for header in &meta.headers {
+        let size = header.layer_size;
+        check_image_size(path, size.width() as u64, size.height() as u64, header.channels.list.len() as u64)?;
+    }
+    Ok(())
+}
+
 fn read_exr(path: &Path) -> Result<Bitmap> {
     use exr::prelude::traits::*;
-    if let Err(e) = std::fs::metadata(path) {
-        return Err(Error::io(path, e));
-    }
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| Error::image(path, format!("cannot read OpenEXR: {e}")))?;
+    let bytes = read_bounded(path, limits::MAX_IMAGE_FILE_BYTES, "an image file")?;
+    check_exr_header(path, &bytes)?;
+    let image = guard_parser(path, || {
+        read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(std::io::Cursor::new(&bytes[..]))
+            .map_err(|e| Error::image(path, format!("cannot read OpenEXR: {e}")))
+    })?;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
     let channels = &layer.channel_data.list;
@@ -136,27 +191,6 @@ fn read_exr(path: &Path) -> Result<Bitmap> {
         }
     }
     Ok(Bitmap { width: w, height: h, channels: n, data })
-}
-
-/// A temporary path beside `path`, in the same directory so that the rename is atomic.
-fn temporary_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.partial-{}", std::process::id()))
-}
-
-/// Write through a temporary file, then rename it over `path`.
-fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let tmp = temporary_path(path);
-    match write(&tmp) {
-        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            Error::io(path, e)
-        }),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(e)
-        }
-    }
 }
 
 /// Write named float channels (each `width * height` values, row 0 at the top) to an OpenEXR
@@ -261,17 +295,6 @@ mod tests {
         // JPEG is lossy: within a couple of code values of 200.
         assert!((srgb.data[0] - 0.5776).abs() < 0.01, "{}", srgb.data[0]);
         assert!((linear.data[0] - 200.0 / 255.0).abs() < 0.01, "{}", linear.data[0]);
-    }
-
-    #[test]
-    fn failed_write_keeps_the_old_file() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("keep.exr");
-        std::fs::write(&path, b"good").unwrap();
-        let result = write_atomically(&path, |_| Err(Error::image(&path, "simulated failure")));
-        assert!(result.is_err());
-        assert_eq!(std::fs::read(&path).unwrap(), b"good");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]

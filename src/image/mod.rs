@@ -9,5 +9,4 @@ mod io;
 
 pub use bitmap::{Bitmap, ColorSpace};
 pub use film::{Aov, Film, PixelSum};
-pub(crate) use io::srgb_decode_colors;
-pub use io::{OutputFormat, read_bitmap, read_bitmap_raw, write_exr, write_image, write_png};
+pub use io::{OutputFormat, decode_image, read_bitmap, read_bitmap_raw, write_exr, write_image, write_png};

@@ -11,9 +11,11 @@ use crate::bsdf::PlasticTables;
 use crate::camera::{FovAxis, PerspectiveCamera};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
+use crate::files::read_text_bounded;
 use crate::geometry::{TriangleMesh, obj, shapes};
 use crate::image::{ColorSpace, read_bitmap, read_bitmap_raw};
 use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
+use crate::limits;
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
 };
@@ -25,12 +27,12 @@ use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
-/// Largest image side accepted.
-const MAX_RESOLUTION: u32 = 32_768;
-/// Largest pixel count accepted (a 16k x 16k image).
-const MAX_PIXELS: u64 = 1 << 28;
-/// Largest sample count per pixel accepted.
-const MAX_SPP: u32 = 1 << 24;
+/// Largest absolute index of refraction accepted: above every transparent material's (diamond
+/// 2.42, germanium 4 in the infrared).
+const MAX_IOR: f32 = 10.0;
+/// Largest radiance of an emitter or environment: far above the sun's (1.6e9 W m^-2 sr^-1),
+/// and small enough that the film's per-pixel variance stays finite in 32-bit floats.
+const MAX_RADIANCE: f32 = 1e15;
 
 /// Settings given on the command line that replace the scene file's.
 #[derive(Clone, Copy, Debug, Default)]
@@ -49,7 +51,7 @@ pub struct SceneOverrides {
 
 /// Load a scene file.
 pub fn load_scene(path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = read_scene_file(path)?;
     load_scene_str(&text, path, overrides)
 }
 
@@ -59,18 +61,44 @@ pub fn load_scene_str(text: &str, path: &Path, overrides: &SceneOverrides) -> Re
     Loader::new(path, &desc).load(&desc, overrides)
 }
 
-/// Parse a scene file's text; errors give the line.
+/// The text of a scene file, within [`limits::MAX_SCENE_FILE_BYTES`].
+fn read_scene_file(path: &Path) -> Result<String> {
+    read_text_bounded(path, limits::MAX_SCENE_FILE_BYTES, "a scene file")
+}
+
+/// Parse a scene file's text; errors give the line, or the key of a number that is not finite.
 fn parse_scene(text: &str, path: &Path) -> Result<SceneDesc> {
-    toml::from_str(text).map_err(|e| {
+    let syntax_error = |e: toml::de::Error| {
         let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
         Error::Scene { path: path.to_path_buf(), line, msg: e.message().to_string() }
-    })
+    };
+    let table: toml::Table = toml::from_str(text).map_err(syntax_error)?;
+    check_numbers(&toml::Value::Table(table), "").map_err(|msg| Error::scene(path, msg))?;
+    toml::from_str(text).map_err(syntax_error)
+}
+
+/// An error naming the first number under `value` (at key path `key`) that is not a finite
+/// 32-bit float: TOML allows `nan` and `inf`, and 1e300 becomes infinite in an f32. Every
+/// parameter tessera reads is such a float or an integer.
+fn check_numbers(value: &toml::Value, key: &str) -> Result<(), String> {
+    match value {
+        toml::Value::Float(x) if !(x.abs() <= f32::MAX as f64) => {
+            Err(format!("{key}: {x} is not a finite number tessera can represent (32-bit float)"))
+        }
+        toml::Value::Array(items) => {
+            items.iter().enumerate().try_for_each(|(i, v)| check_numbers(v, &format!("{key}[{i}]")))
+        }
+        toml::Value::Table(table) => table
+            .iter()
+            .try_for_each(|(k, v)| check_numbers(v, &if key.is_empty() { k.clone() } else { format!("{key}.{k}") })),
+        _ => Ok(()),
+    }
 }
 
 /// Load the texture `name` of a scene file alone, as a colour (8-bit images sRGB-decoded) or
 /// as data (`color` false), for `tessera bake`.
 pub fn load_texture(path: &Path, name: &str, color: bool) -> Result<Texture> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    let text = read_scene_file(path)?;
     let desc = parse_scene(&text, path)?;
     let role = if color { Role::Color } else { Role::Data };
     Ok(Loader::new(path, &desc).build_texture(name, role, "--texture")?.0)
@@ -157,8 +185,8 @@ impl<'a> Loader<'a> {
             };
             let transform = self.transform(&shape.transform, &item)?;
             let emission = match shape.emission {
-                Some(RgbValue(e)) if e.iter().any(|v| *v < 0.0) => {
-                    return Err(self.error(format!("{item}.emission: negative radiance {e:?}")));
+                Some(RgbValue(e)) if e.iter().any(|v| !(0.0..=MAX_RADIANCE).contains(v)) => {
+                    return Err(self.error(format!("{item}.emission: {e:?} is outside [0, {MAX_RADIANCE:e}]")));
                 }
                 Some(RgbValue(e)) if e.iter().any(|v| *v > 0.0) => Some(Rgb::from(e)),
                 _ => None,
@@ -170,6 +198,11 @@ impl<'a> Loader<'a> {
                     mesh.flip_normals();
                 }
                 let cleanup = mesh.validate().map_err(|msg| self.error(format!("{item}: {msg}")))?;
+                let triangles = (geometry.triangles.len() + mesh.indices.len()) as u64;
+                if triangles > limits::MAX_TRIANGLES {
+                    let msg = limits::exceeded("the scene's triangle count", triangles, limits::MAX_TRIANGLES);
+                    return Err(self.error(format!("{item}: {msg}")));
+                }
                 if cleanup.degenerate_triangles > 0 {
                     self.warnings.push(format!(
                         "{}: {item}: dropped {} zero-area triangles",
@@ -197,6 +230,21 @@ impl<'a> Loader<'a> {
             Some(env) => Some(self.environment(env)?),
             None => None,
         };
+        if geometry.shapes.is_empty() {
+            self.warnings
+                .push(format!("{}: the scene has no shapes: only the environment is seen", self.path.display()));
+        }
+        let environment_emits = match &lights.environment {
+            None => false,
+            Some(Environment::Constant(c)) => c.max_element() > 0.0,
+            Some(Environment::Map(_)) => true,
+        };
+        if lights.area.is_empty() && !environment_emits {
+            self.warnings.push(format!(
+                "{}: the scene has no light (no emission, no environment): the image will be black",
+                self.path.display()
+            ));
+        }
         let camera = self.camera(&desc.camera, &settings)?;
         let accel = Accel::build(&geometry.all_triangle_positions());
         Ok(Scene {
@@ -217,22 +265,17 @@ impl<'a> Loader<'a> {
         let height = o.height.unwrap_or(r.height);
         let spp = o.spp.unwrap_or(r.spp);
         let max_depth = o.max_depth.unwrap_or(r.max_depth);
-        if width == 0
-            || height == 0
-            || width > MAX_RESOLUTION
-            || height > MAX_RESOLUTION
-            || width as u64 * height as u64 > MAX_PIXELS
-        {
+        let (side, pixels) = (limits::MAX_RENDER_SIDE, limits::MAX_RENDER_PIXELS);
+        if width == 0 || height == 0 || width > side || height > side || width as u64 * height as u64 > pixels {
             return Err(Error::param(
                 "render.width/height",
-                format!("{width}x{height} is outside 1..{MAX_RESOLUTION} per side and {MAX_PIXELS} pixels"),
+                format!("{width}x{height} is outside 1..={side} per side and {pixels} pixels (docs/limits.md)"),
             )
             .in_scene(self.path, "render"));
         }
-        if spp == 0 || spp > MAX_SPP {
-            return Err(
-                Error::param("render.spp", format!("{spp} is outside 1..={MAX_SPP}")).in_scene(self.path, "render")
-            );
+        if spp == 0 || spp > limits::MAX_SPP {
+            let msg = format!("{spp} is outside 1..={} (docs/limits.md)", limits::MAX_SPP);
+            return Err(Error::param("render.spp", msg).in_scene(self.path, "render"));
         }
         let max_depth = match max_depth {
             -1 => None,
@@ -279,6 +322,16 @@ impl<'a> Loader<'a> {
             )));
         }
         self.textures_in_progress.push(name.to_string());
+        let is_synthesis = |n: &String| matches!(self.texture_descs.get(n), Some(TextureDesc::TilingBlending(_)));
+        let nesting = self.textures_in_progress.iter().filter(|n| is_synthesis(n)).count();
+        if nesting > limits::MAX_TILING_BLENDING_NESTING {
+            let chain = self.textures_in_progress.join(" -> ");
+            let limit = limits::MAX_TILING_BLENDING_NESTING;
+            return Err(self.error(format!(
+                "textures.{name}: tiling_blending textures nest {nesting} deep ({chain}), over tessera's limit of {limit} \
+                 (docs/limits.md): each level triples the cost of a lookup"
+            )));
+        }
         let texture = match desc {
             TextureDesc::Image { filename, filter, scale, offset, .. } => {
                 let file = self.resolve_path(filename);
@@ -490,9 +543,17 @@ impl<'a> Loader<'a> {
         TextureId(self.textures.len() as u32 - 1)
     }
 
+    /// A reflectance or transmittance: a constant in [0, 1] (more would create energy), or a
+    /// texture with a non-negative scale.
     fn color(&mut self, v: Option<&ColorValue>, default: f32, item: &str) -> Result<ColorParam> {
         Ok(match v {
             None => ColorParam::Value(Rgb::splat(default)),
+            Some(ColorValue::Value(c)) if c.iter().any(|x| !(0.0..=1.0).contains(x)) => {
+                return Err(self.error(format!("{item}: {c:?} is not a reflectance in [0, 1]")));
+            }
+            Some(ColorValue::Texture { scale, .. }) if scale.iter().any(|x| *x < 0.0) => {
+                return Err(self.error(format!("{item}: the scale {scale:?} is negative")));
+            }
             Some(ColorValue::Value(c)) => ColorParam::Value(Rgb::from(*c)),
             Some(ColorValue::Texture { name, scale }) => {
                 ColorParam::Texture { id: self.texture(name, Role::Color, item)?, scale: Rgb::from(*scale) }
@@ -544,8 +605,10 @@ impl<'a> Loader<'a> {
                 named_ior(name).ok_or_else(|| self.error(format!("{item}: unknown IOR name '{name}'")))?
             }
         };
-        if !(ior > 0.0 && ior < 100.0) {
-            return Err(self.error(format!("{item}: {ior} is not an index of refraction")));
+        if !(1.0..=MAX_IOR).contains(&ior) {
+            return Err(
+                self.error(format!("{item}: {ior} is not an index of refraction of a real material (1 to {MAX_IOR})"))
+            );
         }
         Ok(ior)
     }
@@ -595,7 +658,15 @@ impl<'a> Loader<'a> {
                             "{item}.material: unknown conductor '{name}' (known: Al, none; or give eta and k)"
                         ))
                     })?,
-                    (None, Some(RgbValue(e)), Some(RgbValue(k))) => (Rgb::from(*e), Rgb::from(*k)),
+                    (None, Some(RgbValue(e)), Some(RgbValue(k))) => {
+                        if !e.iter().all(|x| *x > 0.0 && *x <= MAX_IOR) || !k.iter().all(|x| (0.0..=100.0).contains(x))
+                        {
+                            return Err(self.error(format!(
+                                "{item}: eta {e:?} and k {k:?} are not a conductor's (eta in (0, {MAX_IOR}], k in [0, 100])"
+                            )));
+                        }
+                        (Rgb::from(*e), Rgb::from(*k))
+                    }
                     (None, None, None) => named_conductor("none").expect("in the table"),
                     _ => return Err(self.error(format!("{item}: give either material or both eta and k"))),
                 };
@@ -790,6 +861,12 @@ impl<'a> Loader<'a> {
                 if !(3..=65_536).contains(&segments) || !(2..=65_536).contains(&rings) {
                     return Err(self.error(format!("{item}: a uv_sphere needs 3..65536 segments and 2..65536 rings")));
                 }
+                let triangles = 2 * segments as u64 * rings as u64;
+                if triangles > limits::MAX_TRIANGLES {
+                    let msg =
+                        limits::exceeded("its triangle count (2 segments rings)", triangles, limits::MAX_TRIANGLES);
+                    return Err(self.error(format!("{item}: {msg}")));
+                }
                 vec![(shapes::uv_sphere(segments, rings), None)]
             }
         })
@@ -798,14 +875,14 @@ impl<'a> Loader<'a> {
     fn environment(&mut self, env: &EnvironmentDesc) -> Result<Environment> {
         Ok(match env {
             EnvironmentDesc::Constant { radiance: RgbValue(c) } => {
-                if c.iter().any(|v| *v < 0.0) {
-                    return Err(self.error(format!("environment.radiance: negative radiance {c:?}")));
+                if c.iter().any(|v| !(0.0..=MAX_RADIANCE).contains(v)) {
+                    return Err(self.error(format!("environment.radiance: {c:?} is outside [0, {MAX_RADIANCE:e}]")));
                 }
                 Environment::Constant(Rgb::from(*c))
             }
             EnvironmentDesc::Envmap { filename, scale } => {
-                if !(scale.is_finite() && *scale >= 0.0) {
-                    return Err(self.error(format!("environment.scale: {scale} is not a non-negative number")));
+                if !(0.0..=MAX_RADIANCE).contains(scale) {
+                    return Err(self.error(format!("environment.scale: {scale} is outside [0, {MAX_RADIANCE:e}]")));
                 }
                 let file = self.resolve_path(filename);
                 let image = read_bitmap(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, "environment"))?;

@@ -63,6 +63,18 @@ impl Deformation {
     }
 }
 
+/// Largest magnitude of an entry of F: a texture shown 2^20 times smaller than its exemplar
+/// is far below any texel of any exemplar, so larger values change nothing but the risk of
+/// overflow.
+pub const MAX_DEFORMATION: f32 = (1 << 20) as f32;
+
+/// `m` with each entry clamped to [-MAX_DEFORMATION, MAX_DEFORMATION], NaN to 0.
+#[inline]
+fn bounded(m: Mat2) -> Mat2 {
+    let clamp = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(-MAX_DEFORMATION, MAX_DEFORMATION) };
+    Mat2::from_cols_array(&m.to_cols_array().map(clamp))
+}
+
 /// A deformation field: the product F = F_1 F_2 ... F_n of its factors (identity when empty).
 #[derive(Clone, Debug, Default)]
 pub struct DeformationField {
@@ -77,11 +89,14 @@ impl DeformationField {
 
     /// F at `uv`.
     #[inline]
+    /// Each factor and the product have their entries bounded by [`MAX_DEFORMATION`] (NaN, as
+    /// infinity times zero would give, becomes 0): an analytic field grows without bound over
+    /// the UV plane (a scale 2^(gradient . u)), and what it gives must stay finite.
     pub fn at(&self, uv: Vec2) -> Mat2 {
         match self.factors.as_slice() {
             [] => Mat2::IDENTITY,
-            [only] => only.at(uv),
-            [first, rest @ ..] => rest.iter().fold(first.at(uv), |m, f| m * f.at(uv)),
+            [only] => bounded(only.at(uv)),
+            [first, rest @ ..] => rest.iter().fold(bounded(first.at(uv)), |m, f| bounded(m * bounded(f.at(uv)))),
         }
     }
 
