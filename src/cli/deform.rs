@@ -9,6 +9,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use tessera::deform::{DeformationMaps, Orientation, channel_std, deformation_maps, distortion, seam_metric};
 use tessera::error::{Error, Result};
+use tessera::files::StagedFolder;
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
 use tessera::limits;
@@ -66,6 +67,14 @@ impl MeshArgs {
                 "warning: {}: {} triangles are degenerate in 3D or in UV; their grid samples take the nearest triangle's values",
                 self.mesh.display(),
                 maps.degenerate
+            );
+        }
+        if maps.overlap.overlapped > 0 {
+            eprintln!(
+                "warning: {}: {:.2}% of the UV area is covered by more than one triangle (overlapping UV islands): \
+                 the F map holds one deformation per texel, so those parts of the surface share one",
+                self.mesh.display(),
+                100.0 * maps.overlap.fraction()
             );
         }
         if maps.cuts.non_manifold > 0 {
@@ -134,18 +143,20 @@ fn print_distortion(mesh: &TriangleMesh, field: &DeformationField) {
 /// `tessera deform`.
 pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     let (mesh, maps, [loaded, computed]) = args.maps()?;
-    std::fs::create_dir_all(output).map_err(|e| Error::io(output, e))?;
+    // All five files or none: a failure halfway leaves the folder as it was.
+    let staged = StagedFolder::new(output)?;
     let write_map = |name: &str, map: &tessera::image::Bitmap| {
         let plane = |c: usize| map.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
         let channels = ["R", "G", "B", "A"].iter().enumerate().map(|(c, name)| (name.to_string(), plane(c))).collect();
-        write_exr(&output.join(name), map.width, map.height, channels)
+        write_exr(&staged.path().join(name), map.width, map.height, channels)
     };
     write_map("f_map.exr", &maps.f_map)?;
     write_map("cut_map.exr", &maps.cut_map)?;
     let (det, orientation_picture) = tessera::deform::f_map_pictures(&maps.f_map);
-    write_image(&output.join("det_f.png"), &det, &[])?;
-    write_image(&output.join("orientation.png"), &orientation_picture, &[])?;
-    write_image(&output.join("cells.png"), &tessera::deform::cut_map_picture(&maps.cut_map), &[])?;
+    write_image(&staged.path().join("det_f.png"), &det, &[])?;
+    write_image(&staged.path().join("orientation.png"), &orientation_picture, &[])?;
+    write_image(&staged.path().join("cells.png"), &tessera::deform::cut_map_picture(&maps.cut_map), &[])?;
+    staged.commit()?;
     print_distortion(&mesh, &f_map_field(&maps));
     let res = args.res;
     eprintln!(

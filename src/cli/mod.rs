@@ -260,7 +260,15 @@ fn default_output(scene: &Path) -> PathBuf {
 }
 
 fn load(path: &Path, overrides: &SceneOverrides, quiet: bool) -> Result<Scene> {
-    let scene = load_scene(path, overrides)?;
+    // Loading grows with the scene (meshes, BVH, textures' MIP maps): a spinner with the
+    // elapsed time shows that a long load is working (drawn only on a terminal).
+    let spinner = if quiet { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
+    spinner.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {msg}").expect("valid template"));
+    spinner.set_message(format!("loading {}", path.display()));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let scene = load_scene(path, overrides);
+    spinner.finish_and_clear();
+    let scene = scene?;
     if !quiet {
         for w in &scene.warnings {
             eprintln!("warning: {w}");

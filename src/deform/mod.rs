@@ -9,16 +9,19 @@ mod geodesic;
 mod gradient;
 mod grid;
 mod nearest;
+mod overlap;
 mod seams;
 
 pub use cuts::{BoundaryCell, CutEdge, Cuts};
 pub use distortion::{Distortion, distortion};
 pub use gradient::{TriangleDeformation, deformation_gradient};
 pub use grid::{FieldGrid, FieldSample};
+pub use overlap::{UvOverlap, uv_overlap};
 pub use seams::{channel_std, seam_metric};
 
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
+use crate::limits;
 use glam::{Vec2, Vec3};
 
 /// The tangent field o that orients the texture (Sec. 4.3).
@@ -87,6 +90,8 @@ pub struct DeformationMaps {
     pub degenerate: usize,
     /// Triangles whose UVs are mirrored (R is a reflection there).
     pub mirrored: usize,
+    /// How much of the UV square more than one triangle covers, at the maps' resolution.
+    pub overlap: UvOverlap,
 }
 
 /// Derive the deformation field of `mesh` (which must have UVs): F = R(theta) S per triangle,
@@ -101,9 +106,14 @@ pub fn deformation_maps(
     res: usize,
     tile_size: f32,
 ) -> Result<DeformationMaps, String> {
+    mesh.check()?;
     let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
     if grid == 0 || res == 0 {
         return Err("the grid and the map need at least one sample per side".into());
+    }
+    if grid > limits::MAX_DEFORM_GRID as usize || res > limits::MAX_DEFORM_RES as usize {
+        let (max_grid, max_res) = (limits::MAX_DEFORM_GRID, limits::MAX_DEFORM_RES);
+        return Err(format!("grid {grid} or maps {res} over tessera's limits of {max_grid} and {max_res} per side"));
     }
     if let Orientation::PerVertex(tangents) = orientation {
         if tangents.len() != mesh.positions.len() || !tangents.iter().all(|t| t.is_finite()) {
@@ -149,9 +159,10 @@ pub fn deformation_maps(
             px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
         }
     }
+    let overlap = uv_overlap(&uv_triangles, res);
     let cuts = Cuts::new(mesh, 2.0 * tile_size);
     let cut_map = cuts.cut_map(&f_map, std::f32::consts::SQRT_2 * tile_size);
-    Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored })
+    Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored, overlap })
 }
 
 /// Pictures of an F map for people to look at: log2 |det F| as grey (0.5 at 1, black at 1/16,

@@ -27,7 +27,9 @@ use super::Scene;
 use crate::camera::FovAxis;
 use crate::color::Rgb;
 use crate::error::{Error, Result};
+use crate::files::StagedFolder;
 use crate::image::write_exr;
+use crate::limits;
 use crate::light::Environment;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
 use crate::texture::{BakeFootprint, Channel, Filter, Texture, bake};
@@ -358,11 +360,19 @@ impl Exporter<'_> {
 
 /// Write `scene` as Mitsuba 3 XML to `dir/scene.xml`, with meshes and textures beside it;
 /// procedural textures are baked at `bake_res` x `bake_res`.
+/// The files are written to a staging folder and moved into `dir` only once all are written,
+/// so that a failure leaves `dir` as it was (no mix of old and new files, no empty folders).
 pub fn export_mitsuba(scene: &Scene, dir: &Path, bake_res: usize) -> Result<MitsubaExport> {
-    for sub in ["", "meshes", "textures"] {
-        std::fs::create_dir_all(dir.join(sub)).map_err(|e| Error::io(dir.join(sub), e))?;
+    if !(1..=limits::MAX_BAKE_RES as usize).contains(&bake_res) {
+        return Err(Error::param("bake resolution", format!("{bake_res} is outside 1..={}", limits::MAX_BAKE_RES)));
     }
-    let mut ex = Exporter { scene, dir, baked: HashMap::new(), bake_res, out: MitsubaExport::default() };
+    let staged = StagedFolder::new(dir)?;
+    for sub in ["meshes", "textures"] {
+        let folder = staged.path().join(sub);
+        std::fs::create_dir(&folder).map_err(|e| Error::io(&folder, e))?;
+    }
+    let mut ex =
+        Exporter { scene, dir: staged.path(), baked: HashMap::new(), bake_res, out: MitsubaExport::default() };
     let s = &scene.settings;
     let max_depth = s.max_depth.map_or(-1, i64::from);
     let mut xml = format!(
@@ -392,7 +402,9 @@ pub fn export_mitsuba(scene: &Scene, dir: &Path, bake_res: usize) -> Result<Mits
     let env = ex.environment()?;
     let _ = writeln!(xml, "{env}\n</scene>");
     ex.write_text("scene.xml", &xml)?;
-    ex.out.warnings.sort();
-    ex.out.warnings.dedup();
-    Ok(ex.out)
+    let mut out = ex.out;
+    out.warnings.sort();
+    out.warnings.dedup();
+    staged.commit()?;
+    Ok(out)
 }

@@ -11,14 +11,17 @@ pub use mitsuba::{MitsubaExport, export_mitsuba};
 
 /// One mesh file's surface, by extension: OBJ (no tangents), or glTF 2.0 (.gltf, .glb: every
 /// triangle primitive in world space, with per-vertex tangents where every primitive has
-/// TANGENT). For `tessera deform`, which needs the surface and its UVs, not a scene.
+/// TANGENT). For `tessera deform`, which needs the surface and its UVs, not a scene; checked as
+/// [`TriangleMesh::check`] does (degenerate triangles are kept: `deform` counts them).
 pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Option<Vec<Vec3>>)> {
     let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
-    match extension.as_deref() {
-        Some("gltf" | "glb") => gltf::import_surface(path),
-        Some("obj") => Ok((crate::geometry::obj::load_obj(path)?, None)),
-        _ => Err(crate::Error::mesh(path, "expected a mesh file ending in .obj, .gltf or .glb")),
-    }
+    let (mesh, tangents) = match extension.as_deref() {
+        Some("gltf" | "glb") => gltf::import_surface(path)?,
+        Some("obj") => (crate::geometry::obj::load_obj(path)?, None),
+        _ => return Err(crate::Error::mesh(path, "expected a mesh file ending in .obj, .gltf or .glb")),
+    };
+    mesh.check().map_err(|msg| crate::Error::mesh(path, msg))?;
+    Ok((mesh, tangents))
 }
 
 use crate::accel::{Accel, Hit};
