@@ -103,6 +103,14 @@ impl StagedFolder {
     pub fn commit(mut self) -> Result<Vec<PathBuf>> {
         let mut files = Vec::new();
         collect_files(&self.staging, Path::new(""), &mut files)?;
+        // Refuse before moving anything if a file cannot land (a folder in its place), so that
+        // the folder ends with all the new files or none.
+        for relative in &files {
+            let to = self.target.join(relative);
+            if to.is_dir() || to.ancestors().skip(1).take(relative.components().count()).any(Path::is_file) {
+                return Err(Error::io(&to, std::io::Error::other("cannot be written: a folder or file is in the way")));
+            }
+        }
         let mut moved = Vec::with_capacity(files.len());
         for relative in files {
             let to = self.target.join(&relative);

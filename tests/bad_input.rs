@@ -5,6 +5,7 @@ mod common;
 
 use common::{load, scene_dir};
 use std::process::Command;
+use tessera::image::Aov;
 
 const CAMERA: &str = "[camera]\nfov = 40\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n";
 
@@ -142,7 +143,11 @@ fn absurd_parameters_are_rejected() {
         &[],
         &["unknown IOR name"],
     );
-    error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = -1\n"), &[], &["emission", "outside [0, 1e15]"]);
+    error_of(
+        &format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = -1\n"),
+        &[],
+        &["emission", "outside [0, 1e15]"],
+    );
     error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\ntransform = [{{ scale = 0 }}]\n"), &[], &["singular"]);
 }
 
@@ -357,4 +362,335 @@ fn cli_bake_names_unknown_textures_and_writes_images() {
     assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
     let image = tessera::image::read_bitmap(&out, tessera::image::ColorSpace::Linear).unwrap();
     assert_eq!((image.width, image.height, image.channels), (16, 16, 4));
+}
+
+/// A small glTF document (`common::small_gltf`) edited by `edit`, as a GLB.
+fn edited_glb(edit: impl Fn(String) -> String) -> Vec<u8> {
+    let (json, bin) = common::small_gltf();
+    common::glb(&edit(json), &bin)
+}
+
+#[test]
+fn gltf_documents_the_gltf_crate_would_panic_on_are_errors() {
+    let scene = format!("{CAMERA}[[shapes]]\ntype = \"gltf\"\nfilename = \"m.glb\"\n");
+    let fails = |glb: Vec<u8>, needles: &[&str]| {
+        let msg = error_of(&scene, &[("m.glb", &glb)], needles);
+        // `tessera deform` reads the same file through load_surface: the same error, no panic.
+        let dir = scene_dir("", &[("m.glb", &glb)]);
+        let surface = tessera::scene::load_surface(&dir.path().join("m.glb")).map(|_| ()).unwrap_err().to_string();
+        assert!(needles.iter().all(|n| surface.contains(n)), "{surface} lacks {needles:?}");
+        msg
+    };
+    let swap = |from: &'static str, to: &'static str| {
+        move |json: String| {
+            assert!(json.contains(from), "{from}");
+            json.replacen(from, to, 1)
+        }
+    };
+    // The unedited document loads.
+    let dir = scene_dir(&scene, &[("m.glb", &edited_glb(|j| j))]);
+    load(dir.path()).expect("the small glTF loads");
+    fails(edited_glb(swap("\"POSITION\": 0", "\"POSITION\": 99")), &["m.glb", "POSITION is accessor 99"]);
+    fails(edited_glb(swap("\"NORMAL\": 1", "\"NORMAL\": 99")), &["m.glb", "malformed glTF"]);
+    fails(
+        edited_glb(swap(
+            "\"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\"",
+            "\"componentType\": 5121, \"count\": 4, \"type\": \"VEC3\", \"min\"",
+        )),
+        &["m.glb", "accessor 0", "allows"],
+    );
+    fails(
+        edited_glb(swap("\"componentType\": 5123, \"count\": 6", "\"componentType\": 5126, \"count\": 6")),
+        &["m.glb", "indices", "allows"],
+    );
+    fails(
+        edited_glb(swap("\"count\": 4, \"type\": \"VEC2\"", "\"count\": 0, \"type\": \"VEC2\"")),
+        &["m.glb", "TexCoords(0)", "0 values"],
+    );
+    fails(
+        edited_glb(swap("\"count\": 6, \"type\": \"SCALAR\"", "\"count\": 600, \"type\": \"SCALAR\"")),
+        &["m.glb", "reaches past the end"],
+    );
+    fails(
+        edited_glb(swap(
+            "\"byteOffset\": 0, \"byteLength\": 48",
+            "\"byteOffset\": 0, \"byteLength\": 48, \"byteStride\": 4",
+        )),
+        &["m.glb", "byteStride 4"],
+    );
+    fails(
+        edited_glb(swap("\"byteOffset\": 48, \"byteLength\": 48", "\"byteOffset\": 48, \"byteLength\": 4800")),
+        &["m.glb", "past the end of buffer 0"],
+    );
+    fails(edited_glb(swap("{\"mesh\": 0,", "{\"children\": [0], \"mesh\": 0,")), &["m.glb", "cycle"]);
+    fails(edited_glb(swap("{\"camera\": 0,", "{\"children\": [1], \"camera\": 0,")), &["m.glb", "child of both"]);
+    fails(
+        edited_glb(swap(
+            "\"count\": 4, \"type\": \"VEC2\"}",
+            "\"count\": 4, \"type\": \"VEC2\", \"sparse\": {\"count\": 1, \"indices\": {\"bufferView\": 4, \"componentType\": 5123}, \"values\": {\"bufferView\": 2}}}",
+        )),
+        &["m.glb", "sparse"],
+    );
+    // Images: without bufferView or uri; with a bufferView past the buffer. Without a mimeType
+    // the format is read from the data, which works.
+    let msg = error_of(
+        &scene,
+        &[("m.glb", &edited_glb(swap("{\"bufferView\": 5, \"mimeType\": \"image/png\"}", "{}")))],
+        &["m.glb", "image 0"],
+    );
+    assert!(msg.contains("uri") || msg.contains("malformed"), "{msg}");
+    let no_mime = edited_glb(swap(", \"mimeType\": \"image/png\"", ""));
+    load(scene_dir(&scene, &[("m.glb", &no_mime)]).path()).expect("the PNG is recognised by its content");
+    let scene_gltf = format!("{CAMERA}[[shapes]]\ntype = \"gltf\"\nfilename = \"m.gltf\"\n");
+    let (json, _) = common::small_gltf();
+    let external = json.replace("BUFFER_URI", ", \"uri\": \"/dev/zero\"");
+    error_of(&scene_gltf, &[("m.gltf", external.as_bytes())], &["/dev/zero", "not a regular file"]);
+    let remote = json.replace("BUFFER_URI", ", \"uri\": \"https://example.com/b.bin\"");
+    error_of(&scene_gltf, &[("m.gltf", remote.as_bytes())], &["m.gltf", "relative file path"]);
+    // Factors outside glTF's ranges.
+    error_of(
+        &scene,
+        &[("m.glb", &edited_glb(swap("\"metallicFactor\": 0.2", "\"metallicFactor\": -5")))],
+        &["m.glb", "[0, 1]"],
+    );
+}
+
+/// An OpenEXR file of 2 x 2 pixels whose header claims a data window of `side` x `side`.
+fn exr_claiming(side: i32) -> Vec<u8> {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("a.exr");
+    let channels = ["R", "G", "B"].iter().map(|c| (c.to_string(), vec![0.5f32; 4])).collect();
+    tessera::image::write_exr(&p, 2, 2, channels).unwrap();
+    let mut bytes = std::fs::read(&p).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    bytes[at + 8..at + 12].copy_from_slice(&(side - 1).to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&(side - 1).to_le_bytes());
+    bytes
+}
+
+#[test]
+fn sizes_from_files_and_flags_are_limited_before_allocation() {
+    let texture = |file: &str| {
+        format!(
+            "{CAMERA}[textures.t]\ntype = \"image\"\nfilename = \"{file}\"\n[materials.m]\ntype = \"diffuse\"\nreflectance = \"t\"\n"
+        )
+    };
+    error_of(&texture("big.exr"), &[("big.exr", &exr_claiming(100_000))], &["big.exr", "100000", "limit"]);
+    // /dev/zero is read for ever and /dev/urandom has no end: only regular files are read.
+    error_of(&texture("/dev/urandom"), &[], &["/dev/urandom", "not a regular file"]);
+    error_of(&obj_scene("/dev/zero"), &[], &["/dev/zero", "not a regular file"]);
+    let zero_scene = tessera::scene::load_scene(std::path::Path::new("/dev/zero"), &Default::default());
+    assert!(zero_scene.err().unwrap().to_string().contains("not a regular file"));
+    error_of(
+        &format!("{CAMERA}[[shapes]]\ntype = \"uv_sphere\"\nsegments = 65536\nrings = 65536\n"),
+        &[],
+        &["shapes[0]", "uv_sphere", "8192"],
+    );
+    error_of(
+        &format!("{CAMERA}[[shapes]]\ntype = \"uv_sphere\"\nsegments = 8192\nrings = 8192\n"),
+        &[],
+        &["shapes[0]", "134217728", "limit"],
+    );
+    // Tiling and blending nested four deep: each level triples the cost of every lookup.
+    let png = {
+        let mut bytes = Vec::new();
+        image::GrayImage::from_pixel(4, 4, image::Luma([90]))
+            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+            .unwrap();
+        bytes
+    };
+    let chain = |depth: usize| {
+        let mut toml = format!("{CAMERA}[textures.t0]\ntype = \"image\"\nfilename = \"e.png\"\n");
+        for i in 1..=depth {
+            toml += &format!("[textures.t{i}]\ntype = \"tiling_blending\"\nexemplar = \"t{}\"\n", i - 1);
+        }
+        toml + &format!("[materials.m]\ntype = \"diffuse\"\nreflectance = \"t{depth}\"\n")
+    };
+    load(scene_dir(&chain(3), &[("e.png", &png)]).path()).expect("three levels are allowed");
+    error_of(&chain(4), &[("e.png", &png)], &["nest 4 deep", "t4 -> t3 -> t2 -> t1"]);
+    // Flags: clap refuses them before anything runs.
+    let dir = scene_dir(&format!("{CAMERA}[render]\nwidth = 4\nheight = 4\nspp = 1\n"), &[]);
+    for (args, needle) in [
+        (vec!["render", "scene.toml", "--threads", "1000000"], "thread count"),
+        (vec!["deform", "m.obj", "--res", "16384", "-o", "out"], "16384"),
+        (vec!["bake", "scene.toml", "--texture", "t", "--res", "16384", "-o", "b.exr"], "16384"),
+    ] {
+        let out = tessera().current_dir(dir.path()).args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(needle) && !stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn non_finite_values_never_reach_an_output() {
+    // TOML has nan and inf, and 1e300 is infinite as an f32: each is named by its key.
+    error_of("[camera]\nfov = nan\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n", &[], &["camera.fov", "NaN"]);
+    error_of(
+        &format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\ntransform = [{{ translate = [0, 1e300, 0] }}]\n"),
+        &[],
+        &["shapes[0].transform[0].translate[1]"],
+    );
+    // Physically impossible parameters.
+    error_of(
+        &format!("{CAMERA}[materials.m]\ntype = \"diffuse\"\nreflectance = -5\n"),
+        &[],
+        &["materials.m.reflectance", "[0, 1]"],
+    );
+    for ior in ["1e-30", "1e32", "0.5"] {
+        error_of(
+            &format!("{CAMERA}[materials.m]\ntype = \"dielectric\"\nint_ior = {ior}\n"),
+            &[],
+            &["materials.m.int_ior", "index of refraction"],
+        );
+    }
+    error_of(
+        &format!("{CAMERA}[materials.m]\ntype = \"conductor\"\neta = [1, 1, 1]\nk = [-1, 0, 0]\n"),
+        &[],
+        &["materials.m", "conductor"],
+    );
+    error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = 1e30\n"), &[], &["emission", "1e15"]);
+    // A scale field of 2^1000 at u = 1, and a bright emitter: the bake, the AOVs and the
+    // variance stay finite.
+    let exemplar = {
+        let mut bytes = Vec::new();
+        image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))
+            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
+            .unwrap();
+        bytes
+    };
+    let toml = format!(
+        "{CAMERA}[render]\nwidth = 12\nheight = 12\nspp = 4\n[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\nfilter = \"ewa\"\n\
+         [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\ndeformation = [{{ type = \"scale\", scale = 1, gradient = [1000, 0] }}]\n\
+         [materials.m]\ntype = \"diffuse\"\nreflectance = \"tb\"\n[[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\n\
+         [[shapes]]\ntype = \"rectangle\"\nemission = 1e14\ntransform = [{{ translate = [0, 0, 4] }}]\n\
+         [environment]\ntype = \"constant\"\nradiance = 1e14\n"
+    );
+    let (_dir, scene) = common::scene(&toml, &[("e.png", &exemplar)]);
+    let aovs = [Aov::Albedo, Aov::Normal, Aov::Uv, Aov::Footprint];
+    let film = tessera::integrator::render(&scene, None, &aovs, &|_, _| {});
+    for (name, image) in [("radiance", film.radiance()), ("variance", film.variance())]
+        .into_iter()
+        .chain(aovs.iter().map(|a| ("an AOV", film.aov(*a).unwrap())))
+    {
+        assert_eq!(image.non_finite_count(), 0, "{name}");
+    }
+    let texture = &scene.textures[scene.textures.len() - 1];
+    let baked = tessera::texture::bake(texture, 32, tessera::texture::BakeFootprint::Texel);
+    assert_eq!(baked.non_finite_count(), 0);
+}
+
+#[test]
+fn diff_never_passes_a_non_finite_image_or_criterion() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, value: f32| {
+        let p = dir.path().join(name);
+        let channels = ["R", "G", "B"].iter().map(|c| (c.to_string(), vec![value; 16])).collect();
+        tessera::image::write_exr(&p, 4, 4, channels).unwrap();
+        p
+    };
+    let (nan, black, variance) = (write("nan.exr", f32::NAN), write("black.exr", 0.0), write("var.exr", 0.01));
+    let diff = |args: &[&str]| tessera().current_dir(dir.path()).arg("diff").args(args).output().unwrap();
+    let out = diff(&["nan.exr", "black.exr", "--max-relmse", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("FAIL: 48 values of the test image are NaN"));
+    let out = diff(&["nan.exr", "black.exr", "--variance", "var.exr", "--spp", "4"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stdout));
+    let out = diff(&["black.exr", "nan.exr", "--max-relmse", "1"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not usable as a reference"));
+    for args in [["--max-relmse", "nan"], ["--max-flip", "-1"], ["--spp", "0"]] {
+        let mut all = vec!["black.exr", "black.exr", "--variance", "var.exr", "--spp", "4"];
+        all.extend(args);
+        let out = diff(&all);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    assert!(diff(&["black.exr", "black.exr", "--max-relmse", "0"]).status.success());
+    let _ = (nan, black, variance);
+}
+
+/// A 4 x 4 grid of squares with UVs: `overlap` gives the first column the UVs of the third,
+/// so that one UV column holds two islands and the first none.
+fn grid_obj(overlap: bool) -> String {
+    let mut obj = String::new();
+    for j in 0..=4 {
+        for i in 0..=4 {
+            obj += &format!("v {} {} 0\nvt {} {}\n", i as f32 / 4.0, j as f32 / 4.0, i as f32 / 4.0, j as f32 / 4.0);
+        }
+    }
+    for j in 0..4 {
+        for i in 0..4 {
+            let a = j * 5 + i + 1;
+            let (b, c, d) = (a + 1, a + 6, a + 5);
+            if overlap && i == 0 {
+                // Same positions, UVs of the square two to the right: stacked on another island.
+                obj += &format!(
+                    "f {a}/{} {b}/{} {c}/{}\nf {a}/{} {c}/{} {d}/{}\n",
+                    a + 2,
+                    b + 2,
+                    c + 2,
+                    a + 2,
+                    c + 2,
+                    d + 2
+                );
+            } else {
+                obj += &format!("f {a}/{a} {b}/{b} {c}/{c}\nf {a}/{a} {c}/{c} {d}/{d}\n");
+            }
+        }
+    }
+    obj
+}
+
+#[test]
+fn failed_runs_leave_output_folders_as_they_were() {
+    let dir =
+        scene_dir("", &[("m.obj", grid_obj(false).as_bytes()), ("flat.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")]);
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("f_map.exr"), b"the good map").unwrap();
+    // A folder where a file must go: deform fails, and no file of the set is replaced.
+    std::fs::create_dir(out.join("orientation.png")).unwrap();
+    let run = tessera().current_dir(dir.path()).args(["deform", "m.obj", "--res", "16", "-o", "out"]).output().unwrap();
+    assert_eq!(run.status.code(), Some(1), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("orientation.png"));
+    assert_eq!(std::fs::read(out.join("f_map.exr")).unwrap(), b"the good map");
+    // No staging folder is left behind.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 4);
+    // A mesh without UVs fails before anything is written, and makes no folder.
+    let run = tessera().current_dir(dir.path()).args(["deform", "flat.obj", "-o", "new"]).output().unwrap();
+    assert_eq!(run.status.code(), Some(1));
+    assert!(!dir.path().join("new").exists());
+    // With the obstacle gone, all five files are written.
+    std::fs::remove_dir(out.join("orientation.png")).unwrap();
+    let run = tessera().current_dir(dir.path()).args(["deform", "m.obj", "--res", "16", "-o", "out"]).output().unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_ne!(std::fs::read(out.join("f_map.exr")).unwrap(), b"the good map");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 5);
+}
+
+#[test]
+fn lost_data_and_empty_scenes_are_reported() {
+    // UVs on some faces only: an error, not UVs silently dropped.
+    error_of(
+        &obj_scene("p.obj"),
+        &[("p.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\nf 2 4 3\n")],
+        &["p.obj", "some faces have texture coordinates"],
+    );
+    let (_d, scene) = common::scene(CAMERA, &[]);
+    assert!(scene.warnings.iter().any(|w| w.contains("no shapes")), "{:?}", scene.warnings);
+    assert!(scene.warnings.iter().any(|w| w.contains("no light")), "{:?}", scene.warnings);
+    let (_d, lit) = common::scene(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = 1\n"), &[]);
+    assert!(lit.warnings.is_empty(), "{:?}", lit.warnings);
+    // Overlapping UV islands: deform warns with the fraction.
+    let dir = scene_dir("", &[("stacked.obj", grid_obj(true).as_bytes()), ("plain.obj", grid_obj(false).as_bytes())]);
+    let run = |mesh: &str| {
+        let folder = format!("maps-of-{mesh}");
+        let out = tessera().current_dir(dir.path()).args(["deform", mesh, "--res", "32", "-o", &folder]).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let stacked = run("stacked.obj");
+    assert!(stacked.contains("33.33% of the UV area is covered by more than one triangle"), "{stacked}");
+    assert!(!run("plain.obj").contains("overlapping"));
 }

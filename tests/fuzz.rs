@@ -14,6 +14,9 @@
 //! A failing case's input is written to `target/fuzz-failures/`, named by seed and case, to be
 //! turned into a regression test in `tests/bad_input.rs`.
 
+mod common;
+
+use common::{glb, small_gltf};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -122,13 +125,41 @@ impl Rng {
 
 /// Numbers that break parsers and arithmetic.
 const NUMBERS: &[&str] = &[
-    "0", "-0", "1", "-1", "2", "3", "0.5", "-0.5", "1e-30", "1e30", "-1e30", "1e38", "3.5e38", "nan", "inf", "-inf",
-    "255", "256", "65535", "65536", "2147483647", "2147483648", "4294967295", "4294967296", "-2147483648",
-    "9007199254740993", "1e300", "100000", "12", "7",
+    "0",
+    "-0",
+    "1",
+    "-1",
+    "2",
+    "3",
+    "0.5",
+    "-0.5",
+    "1e-30",
+    "1e30",
+    "-1e30",
+    "1e38",
+    "3.5e38",
+    "nan",
+    "inf",
+    "-inf",
+    "255",
+    "256",
+    "65535",
+    "65536",
+    "2147483647",
+    "2147483648",
+    "4294967295",
+    "4294967296",
+    "-2147483648",
+    "9007199254740993",
+    "1e300",
+    "100000",
+    "12",
+    "7",
 ];
 
 /// 32-bit values for binary fields (lengths, counts, offsets).
-const WORDS: &[u32] = &[0, 1, 2, 3, 4, 0x7f, 0x80, 0xff, 0x100, 0xffff, 0x10000, 0x7fff_ffff, 0x8000_0000, 0xffff_ffff, 100_000];
+const WORDS: &[u32] =
+    &[0, 1, 2, 3, 4, 0x7f, 0x80, 0xff, 0x100, 0xffff, 0x10000, 0x7fff_ffff, 0x8000_0000, 0xffff_ffff, 100_000];
 
 /// Mutate binary data: bit flips, interesting bytes and words, chunks inserted, deleted,
 /// duplicated, truncation.
@@ -309,71 +340,6 @@ struct Seed {
     bytes: Vec<u8>,
 }
 
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// A small glTF document exercising what the importer reads: indexed positions, normals,
-/// UVs and tangents, a two-level node hierarchy, a camera, and a material with a base-colour
-/// texture whose PNG lies in a buffer view. Returns (JSON, binary buffer).
-fn small_gltf() -> (String, Vec<u8>) {
-    let mut bin = Vec::new();
-    let floats = |bin: &mut Vec<u8>, values: &[f32]| values.iter().for_each(|v| bin.extend(v.to_le_bytes()));
-    floats(&mut bin, &[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.]); // 0..48 positions
-    floats(&mut bin, &[0., 0., 1., 0., 0., 1., 0., 0., 1., 0., 0., 1.]); // 48..96 normals
-    floats(&mut bin, &[0., 1., 1., 1., 1., 0., 0., 0.]); // 96..128 uvs
-    floats(&mut bin, &[1., 0., 0., 1., 1., 0., 0., 1., 1., 0., 0., 1., 1., 0., 0., 1.]); // 128..192 tangents
-    [0u16, 1, 2, 0, 2, 3].iter().for_each(|i| bin.extend(i.to_le_bytes())); // 192..204 indices
-    bin.extend([0, 0]);
-    let png_start = bin.len();
-    let mut png = std::io::Cursor::new(Vec::new());
-    image::RgbImage::from_fn(4, 4, |x, y| image::Rgb([x as u8 * 60, y as u8 * 60, 128]))
-        .write_to(&mut png, image::ImageFormat::Png)
-        .unwrap();
-    bin.extend(png.into_inner());
-    let png_length = bin.len() - png_start;
-    let json = format!(
-        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0, 2]}}],
-"nodes": [{{"children": [1], "translation": [0, 0, -1]}}, {{"mesh": 0, "scale": [2, 2, 2]}},
- {{"camera": 0, "translation": [0, 0, 3]}}],
-"cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.7, "znear": 0.01}}}}],
-"meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TANGENT": 3}}, "indices": 4, "material": 0}}]}}],
-"materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0.2, "roughnessFactor": 0.5}}}}],
-"textures": [{{"source": 0}}], "images": [{{"bufferView": 5, "mimeType": "image/png"}}],
-"accessors": [
- {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
- {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"}},
- {{"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}},
- {{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4"}},
- {{"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}}],
-"bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
- {{"buffer": 0, "byteOffset": 96, "byteLength": 32}}, {{"buffer": 0, "byteOffset": 128, "byteLength": 64}},
- {{"buffer": 0, "byteOffset": 192, "byteLength": 12}}, {{"buffer": 0, "byteOffset": {png_start}, "byteLength": {png_length}}}],
-"buffers": [{{"byteLength": {}BUFFER_URI}}]}}"#,
-        bin.len()
-    );
-    (json, bin)
-}
-
-/// The glTF document as one GLB file.
-fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
-    let mut json = json.replace("BUFFER_URI", "").into_bytes();
-    json.resize(json.len().next_multiple_of(4), b' ');
-    let mut bin = bin.to_vec();
-    bin.resize(bin.len().next_multiple_of(4), 0);
-    let mut out = Vec::new();
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
-    out.extend((json.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(json);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
-}
-
 /// A small image file of the given format.
 fn small_image(format: image::ImageFormat) -> Vec<u8> {
     let mut out = std::io::Cursor::new(Vec::new());
@@ -388,7 +354,7 @@ fn small_image(format: image::ImageFormat) -> Vec<u8> {
 /// Every seed: the shipped scenes, the shipped meshes and some images, and small generated
 /// files of each format.
 fn seeds() -> Vec<Seed> {
-    let root = repo();
+    let root = common::repo();
     let mut seeds = Vec::new();
     for folder in ["scenes", "scenes/golden"] {
         let mut scenes: Vec<PathBuf> = std::fs::read_dir(root.join(folder))
@@ -448,7 +414,9 @@ fn scene_using(kind: Kind, file: &str) -> String {
                 [camera]\nfov = 50\neye = [0.5, 0.5, 3]\ntarget = [0.5, 0.5, 0]\n";
     match kind {
         Kind::Obj => format!("{head}[[shapes]]\ntype = \"obj\"\nfilename = \"{file}\"\nemission = 1\n"),
-        Kind::Gltf | Kind::Glb => format!("{head}[[shapes]]\ntype = \"gltf\"\nfilename = \"{file}\"\n[environment]\ntype = \"constant\"\nradiance = 1\n"),
+        Kind::Gltf | Kind::Glb => format!(
+            "{head}[[shapes]]\ntype = \"gltf\"\nfilename = \"{file}\"\n[environment]\ntype = \"constant\"\nradiance = 1\n"
+        ),
         _ => format!(
             "{head}[textures.t]\ntype = \"image\"\nfilename = \"{file}\"\nfilter = \"ewa\"\n\
              [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"t\"\nblend = \"histogram_preserving\"\n\
@@ -469,10 +437,15 @@ fn load_and_render(text: &str, path: &Path) -> Result<(), String> {
     let crop = Crop { x0: 0, y0: 0, x1: s.width.min(8), y1: s.height.min(8) };
     let aovs = [Aov::Albedo, Aov::Normal, Aov::Uv, Aov::Footprint];
     let film = render(&scene, Some(crop), &aovs, &|_, _| {});
-    let mut images: Vec<(String, Bitmap)> = vec![("radiance".into(), film.radiance()), ("variance".into(), film.variance())];
+    let mut images: Vec<(String, Bitmap)> =
+        vec![("radiance".into(), film.radiance()), ("variance".into(), film.variance())];
     images.extend(aovs.iter().map(|a| (format!("{a:?}"), film.aov(*a).unwrap())));
     images.extend(
-        scene.textures.iter().enumerate().map(|(i, t)| (format!("bake of texture {i}"), bake(t, 8, BakeFootprint::Texel))),
+        scene
+            .textures
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (format!("bake of texture {i}"), bake(t, 8, BakeFootprint::Texel))),
     );
     match images.iter().find(|(_, b)| b.non_finite_count() > 0) {
         Some((name, b)) => Err(format!("{} non-finite values in the {name}", b.non_finite_count())),
@@ -561,7 +534,11 @@ fn fuzz_loaders_with_mutated_inputs() {
                 let (case, index) = *current.lock().unwrap();
                 let input = &seeds[index];
                 let kept = keep_failure(dir.path(), input, seed, case);
-                panic!("case {case} (seed {seed}, mutating {}) ran past {CASE_TIME:?}: {}", input.name.display(), kept.display());
+                panic!(
+                    "case {case} (seed {seed}, mutating {}) ran past {CASE_TIME:?}: {}",
+                    input.name.display(),
+                    kept.display()
+                );
             }
         }
     }
@@ -572,14 +549,20 @@ fn fuzz_loaders_with_mutated_inputs() {
         RENDERED.load(Ordering::Relaxed),
         failures.len()
     );
-    assert!(failures.is_empty(), "{} failing cases (inputs in target/fuzz-failures):\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} failing cases (inputs in target/fuzz-failures):\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }
 
 /// Copy a failing case's input to `target/fuzz-failures/seed-S-case-N-NAME`.
 fn keep_failure(dir: &Path, input: &Seed, seed: u64, case: usize) -> PathBuf {
-    let out = repo().join("target/fuzz-failures");
+    let out = common::repo().join("target/fuzz-failures");
     let _ = std::fs::create_dir_all(&out);
-    let name = if input.kind == Kind::Scene { "input.toml".to_string() } else { input.name.to_string_lossy().into_owned() };
+    let name =
+        if input.kind == Kind::Scene { "input.toml".to_string() } else { input.name.to_string_lossy().into_owned() };
     let kept = out.join(format!("seed-{seed}-case-{case}-{name}"));
     let _ = std::fs::copy(dir.join(&name), &kept);
     kept

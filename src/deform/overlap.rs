@@ -99,9 +99,8 @@ mod tests {
     #[test]
     fn uv_overlap_of_a_tiled_square_is_zero() {
         // A 5 x 5 grid of squares, each two triangles: edges shared in every direction.
-        let triangles: Vec<[Vec2; 3]> = (0..25)
-            .flat_map(|k| square(Vec2::new((k % 5) as f32, (k / 5) as f32) * 0.2, 0.2))
-            .collect();
+        let triangles: Vec<[Vec2; 3]> =
+            (0..25).flat_map(|k| square(Vec2::new((k % 5) as f32, (k / 5) as f32) * 0.2, 0.2)).collect();
         let o = uv_overlap(&triangles, 64);
         assert_eq!(o, UvOverlap { covered: 64 * 64, overlapped: 0 });
     }

@@ -40,8 +40,12 @@ fn read_gltf(path: &Path) -> Result<GltfFile> {
     let bytes = read_bounded(path, limits::MAX_MESH_FILE_BYTES, "a glTF file")?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     guard_parser(path, || {
-        let gltf::Gltf { document: doc, mut blob } =
-            gltf::Gltf::from_slice(&bytes).map_err(|e| Error::mesh(path, format!("malformed glTF: {e}")))?;
+        let malformed = |e: gltf::Error| Error::mesh(path, format!("malformed glTF: {e}"));
+        // gltf-json's own validation indexes the accessors by each POSITION attribute before it
+        // checks the index: check those first.
+        let unchecked = gltf::Gltf::from_slice_without_validation(&bytes).map_err(malformed)?;
+        check_position_accessors(unchecked.document.as_json()).map_err(|msg| Error::mesh(path, msg))?;
+        let gltf::Gltf { document: doc, mut blob } = gltf::Gltf::from_slice(&bytes).map_err(malformed)?;
         check_node_tree(&doc).map_err(|msg| Error::mesh(path, msg))?;
         let mut buffers = Vec::new();
         for buffer in doc.buffers() {
@@ -95,6 +99,23 @@ fn percent_decode(uri: &str) -> Option<String> {
         }
     }
     String::from_utf8(bytes).ok()
+}
+
+/// An error if a primitive's POSITION names an accessor the document lacks.
+fn check_position_accessors(json: &gltf::json::Root) -> Result<(), String> {
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(index) = primitive.attributes.get(&position).filter(|i| i.value() >= accessors) {
+                return Err(format!(
+                    "mesh {m} primitive {p}: POSITION is accessor {}, but there are {accessors} accessors",
+                    index.value()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// An error unless the nodes form a forest, as glTF requires: no node is the child of two

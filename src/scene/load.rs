@@ -860,7 +860,9 @@ impl<'a> Loader<'a> {
                 let (segments, rings) = (shape.segments.unwrap_or(64), shape.rings.unwrap_or(32));
                 let most = limits::MAX_SPHERE_SEGMENTS;
                 if !(3..=most).contains(&segments) || !(2..=most).contains(&rings) {
-                    return Err(self.error(format!("{item}: a uv_sphere needs 3..={most} segments and 2..={most} rings")));
+                    return Err(
+                        self.error(format!("{item}: a uv_sphere needs 3..={most} segments and 2..={most} rings"))
+                    );
                 }
                 let triangles = 2 * segments as u64 * rings as u64;
                 if triangles > limits::MAX_TRIANGLES {

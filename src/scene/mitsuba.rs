@@ -29,8 +29,8 @@ use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::StagedFolder;
 use crate::image::write_exr;
-use crate::limits;
 use crate::light::Environment;
+use crate::limits;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
 use crate::texture::{BakeFootprint, Channel, Filter, Texture, bake};
 use glam::{Mat4, Vec2, Vec3};
@@ -371,8 +371,7 @@ pub fn export_mitsuba(scene: &Scene, dir: &Path, bake_res: usize) -> Result<Mits
         let folder = staged.path().join(sub);
         std::fs::create_dir(&folder).map_err(|e| Error::io(&folder, e))?;
     }
-    let mut ex =
-        Exporter { scene, dir: staged.path(), baked: HashMap::new(), bake_res, out: MitsubaExport::default() };
+    let mut ex = Exporter { scene, dir: staged.path(), baked: HashMap::new(), bake_res, out: MitsubaExport::default() };
     let s = &scene.settings;
     let max_depth = s.max_depth.map_or(-1, i64::from);
     let mut xml = format!(

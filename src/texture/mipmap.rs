@@ -208,6 +208,12 @@ impl MipMap {
 
     fn ewa(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
         match self.ewa_axes(dst0, dst1) {
+            // A footprint wider than the whole image reads the coarsest level, whose one texel
+            // every weight would fall on (pbrt-v4 returns it too): looping over the ellipse
+            // there would cost its area in texels, without bound.
+            Some((_, _, shorter)) if shorter.log2() >= (self.levels.len() - 1) as f32 => {
+                self.texel(self.levels.len() - 1, 0, 0)
+            }
             Some((dst0, dst1, shorter)) => {
                 self.at_level(self.lod(shorter), |level| self.ewa_level(level, st, dst0, dst1))
             }
@@ -220,6 +226,10 @@ impl MipMap {
     fn ewa_level(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
         let l = &self.levels[level];
         let res = Vec2::new(l.width as f32, l.height as f32);
+        // The image repeats: start from the first period, so that the ellipse's bounds below are
+        // a few texels apart however far out `st` is (far out, adjacent floats are millions of
+        // texels apart, and the loops would run over all of them).
+        let st = st - st.floor();
         let c = st * res - Vec2::splat(0.5);
         let (d0, d1) = (dst0 * res, dst1 * res);
         // Implicit ellipse A x^2 + B x y + C y^2 < 1; the +1 keeps at least a texel's width.

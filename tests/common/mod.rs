@@ -300,3 +300,65 @@ pub fn assert_filtered_renders_converge(render_with: impl Fn(&str, u32) -> tesse
         assert!((mean(&low) - mean(&reference)).abs() < 0.01 * mean(&reference), "{filter}: mean drifts");
     }
 }
+
+/// A small glTF document exercising what the importer reads: indexed positions, normals,
+/// UVs and tangents, a two-level node hierarchy, a camera, and a material with a base-colour
+/// texture whose PNG lies in a buffer view. Returns (JSON, binary buffer); the JSON's buffer
+/// ends in the placeholder `BUFFER_URI`, for a `, "uri": ...` or nothing (a GLB).
+pub fn small_gltf() -> (String, Vec<u8>) {
+    let mut bin = Vec::new();
+    let floats = |bin: &mut Vec<u8>, values: &[f32]| values.iter().for_each(|v| bin.extend(v.to_le_bytes()));
+    floats(&mut bin, &[0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0.]); // 0..48 positions
+    floats(&mut bin, &[0., 0., 1., 0., 0., 1., 0., 0., 1., 0., 0., 1.]); // 48..96 normals
+    floats(&mut bin, &[0., 1., 1., 1., 1., 0., 0., 0.]); // 96..128 uvs
+    floats(&mut bin, &[1., 0., 0., 1., 1., 0., 0., 1., 1., 0., 0., 1., 1., 0., 0., 1.]); // 128..192 tangents
+    [0u16, 1, 2, 0, 2, 3].iter().for_each(|i| bin.extend(i.to_le_bytes())); // 192..204 indices
+    bin.extend([0, 0]);
+    let png_start = bin.len();
+    let mut png = std::io::Cursor::new(Vec::new());
+    image::RgbImage::from_fn(4, 4, |x, y| image::Rgb([x as u8 * 60, y as u8 * 60, 128]))
+        .write_to(&mut png, image::ImageFormat::Png)
+        .unwrap();
+    bin.extend(png.into_inner());
+    let png_length = bin.len() - png_start;
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0, 2]}}],
+"nodes": [{{"children": [1], "translation": [0, 0, -1]}}, {{"mesh": 0, "scale": [2, 2, 2]}},
+ {{"camera": 0, "translation": [0, 0, 3]}}],
+"cameras": [{{"type": "perspective", "perspective": {{"yfov": 0.7, "znear": 0.01}}}}],
+"meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TANGENT": 3}}, "indices": 4, "material": 0}}]}}],
+"materials": [{{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}, "metallicFactor": 0.2, "roughnessFactor": 0.5}}}}],
+"textures": [{{"source": 0}}], "images": [{{"bufferView": 5, "mimeType": "image/png"}}],
+"accessors": [
+ {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}},
+ {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"}},
+ {{"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}},
+ {{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4"}},
+ {{"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}}],
+"bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
+ {{"buffer": 0, "byteOffset": 96, "byteLength": 32}}, {{"buffer": 0, "byteOffset": 128, "byteLength": 64}},
+ {{"buffer": 0, "byteOffset": 192, "byteLength": 12}}, {{"buffer": 0, "byteOffset": {png_start}, "byteLength": {png_length}}}],
+"buffers": [{{"byteLength": {}BUFFER_URI}}]}}"#,
+        bin.len()
+    );
+    (json, bin)
+}
+
+/// The glTF document as one GLB file.
+pub fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut json = json.replace("BUFFER_URI", "").into_bytes();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let mut bin = bin.to_vec();
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + json.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
