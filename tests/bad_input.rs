@@ -686,7 +686,8 @@ fn lost_data_and_empty_scenes_are_reported() {
     let dir = scene_dir("", &[("stacked.obj", grid_obj(true).as_bytes()), ("plain.obj", grid_obj(false).as_bytes())]);
     let run = |mesh: &str| {
         let folder = format!("maps-of-{mesh}");
-        let out = tessera().current_dir(dir.path()).args(["deform", mesh, "--res", "32", "-o", &folder]).output().unwrap();
+        let out =
+            tessera().current_dir(dir.path()).args(["deform", mesh, "--res", "32", "-o", &folder]).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         String::from_utf8_lossy(&out.stderr).into_owned()
     };
