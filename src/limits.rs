@@ -53,15 +53,19 @@ pub const MAX_SPP: u32 = 1 << 24;
 pub const MAX_THREADS: usize = 1024;
 
 /// Largest side of a bake (`tessera bake --res`, `export-mitsuba --bake-res`): 1 GiB of RGBA
-/// floats, about 3 GiB at the peak of writing it.
+/// floats, 3.2 GiB at the peak of writing it.
 pub const MAX_BAKE_RES: u32 = 8192;
 
-/// Largest side of the F map and cut map of `tessera deform` (`--res`): 256 MiB per map, about
-/// 1.5 GiB at the peak with the pictures.
+/// Largest side of the F map and cut map of `tessera deform` (`--res`): 256 MiB per map, 1.9 GiB
+/// at the peak with the pictures.
 pub const MAX_DEFORM_RES: u32 = 4096;
 
 /// Largest side of `tessera deform`'s smoothing grid (`--grid`).
 pub const MAX_DEFORM_GRID: u32 = 4096;
+
+/// Most point pairs `tessera analyze` evaluates per seam metric (cut edges times samples per
+/// edge): the samples per edge are lowered to fit.
+pub const MAX_SEAM_SAMPLES: usize = 1 << 22;
 
 /// Deepest nesting of tiling-and-blending textures (one whose exemplar is another): each level
 /// multiplies the cost of a lookup by the tiles per point (3 for hexagonal tiles), at load

@@ -206,7 +206,16 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize)
         println!("seams: the mesh has no UV cuts");
         return Ok(ExitCode::SUCCESS);
     }
-    let seams = |texture: TilingBlending| seam_metric(&maps.cuts, &texture, spread, samples).unwrap_or(f64::NAN);
+    // The metric's cost is cut edges x samples: bounded, with fewer samples per edge if need be.
+    let edges = maps.cuts.edges.len();
+    let per_edge = samples.min((limits::MAX_SEAM_SAMPLES / edges).max(1));
+    if per_edge < samples {
+        eprintln!(
+            "note: {edges} cut edges: {per_edge} point pairs per edge (at most {} in all)",
+            limits::MAX_SEAM_SAMPLES
+        );
+    }
+    let seams = |texture: TilingBlending| seam_metric(&maps.cuts, &texture, spread, per_edge).unwrap_or(f64::NAN);
     let classical = seams(texture(None, None)?);
     let classical_cells = seams(texture(None, Some(cut_map.clone()))?);
     let deformed = seams(texture(Some(field.clone()), None)?);

@@ -61,3 +61,33 @@ pub(super) fn clamped_pieces(a: glam::Vec2, b: glam::Vec2) -> Vec<[glam::Vec2; 2
     let clamp = |t: f32| (a + d * t).clamp(glam::Vec2::ZERO, glam::Vec2::ONE);
     ts.windows(2).map(|w| [clamp(w[0]), clamp(w[1])]).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    #[test]
+    fn clamped_pieces_follow_the_clamped_segment_and_stay_short() {
+        // Far outside the square: the pieces trace the clamp of the segment, whose length is
+        // bounded by the square's, whatever the segment's.
+        let (a, b) = (Vec2::new(-1e4, -3e4), Vec2::new(2e4, 1e4));
+        let pieces = clamped_pieces(a, b);
+        assert!(pieces.len() <= 5);
+        let length: f32 = pieces.iter().map(|[p, q]| p.distance(*q)).sum();
+        assert!(length <= 4.0, "{length}");
+        for [p, q] in &pieces {
+            for t in [0.0, 0.3, 1.0] {
+                let x = p.lerp(*q, t);
+                assert!(x.cmpge(Vec2::ZERO).all() && x.cmple(Vec2::ONE).all(), "{x}");
+            }
+        }
+        // Consecutive pieces join, and the ends are the clamped end points.
+        assert!(pieces.windows(2).all(|w| w[0][1].distance(w[1][0]) < 1e-6));
+        assert_eq!(pieces[0][0], a.clamp(Vec2::ZERO, Vec2::ONE));
+        assert_eq!(pieces[pieces.len() - 1][1], b.clamp(Vec2::ZERO, Vec2::ONE));
+        // Inside the square a segment is one piece, itself.
+        let inside = clamped_pieces(Vec2::new(0.1, 0.2), Vec2::new(0.7, 0.9));
+        assert_eq!(inside, vec![[Vec2::new(0.1, 0.2), Vec2::new(0.7, 0.9)]]);
+    }
+}

@@ -188,8 +188,8 @@ impl MipMap {
     }
 
     /// The EWA ellipse's axes (longer first, the shorter widened to at most `MAX_ANISOTROPY`
-    /// times shorter than the longer) and the shorter one's length in texels; None when the
-    /// ellipse is degenerate.
+    /// times shorter than the longer) and the shorter one's length in texels (infinite when
+    /// it overflows); None when the ellipse is degenerate.
     fn ewa_axes(&self, mut dst0: Vec2, mut dst1: Vec2) -> Option<(Vec2, Vec2, f32)> {
         let size = self.size();
         if (dst0 * size).length_squared() < (dst1 * size).length_squared() {
@@ -203,7 +203,8 @@ impl MipMap {
             dst1 *= scale;
             shorter *= scale;
         }
-        (shorter > 0.0 && shorter.is_finite()).then_some((dst0, dst1, shorter))
+        // An infinite length (a footprint beyond f32's range) is wider than any image.
+        (shorter > 0.0).then_some((dst0, dst1, shorter))
     }
 
     fn ewa(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
@@ -324,5 +325,20 @@ mod tests {
             let v = m.lookup(filter, st, tiny, tiny.perp()).x;
             assert!((v - m.bilinear(0, st).x).abs() < 0.05, "{filter:?}: {v}");
         }
+    }
+
+    #[test]
+    fn ewa_of_a_footprint_wider_than_the_image_is_its_mean() {
+        let m = MipMap::new(checker(16));
+        let mean = m.level(m.level_count() - 1).pixel(0, 0);
+        for width in [1.0, 3.0, 1e6, 1e30] {
+            let v = m.lookup(Filter::Ewa, Vec2::new(0.3, 0.6), Vec2::new(width, 0.0), Vec2::new(0.0, width));
+            assert_eq!(v, mean, "width {width}");
+        }
+        // Far from the first period, the lookup is that of the same point in the first period
+        // (to float rounding of the far coordinate).
+        let near = m.lookup(Filter::Ewa, Vec2::new(0.25, 0.5), Vec2::new(0.1, 0.0), Vec2::new(0.0, 0.05));
+        let far = m.lookup(Filter::Ewa, Vec2::new(4096.25, -8191.5), Vec2::new(0.1, 0.0), Vec2::new(0.0, 0.05));
+        assert!((near - far).abs().max_element() < 1e-4, "{near} vs {far}");
     }
 }
