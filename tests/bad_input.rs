@@ -67,6 +67,10 @@ fn malformed_obj_is_an_error() {
         &["bad.obj", "malformed OBJ"],
     );
     error_of(&obj_scene("oob.obj"), &[("oob.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")], &["oob.obj"]);
+    // `tessera deform` reads meshes through load_surface: the same checks, no panic in deform/.
+    let dir = scene_dir("", &[("oob.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1/1 2/1 7/1\n")]);
+    let msg = tessera::scene::load_surface(&dir.path().join("oob.obj")).map(|_| ()).unwrap_err().to_string();
+    assert!(msg.contains("oob.obj"), "{msg}");
     error_of(
         &obj_scene("nan.obj"),
         &[("nan.obj", b"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n")],

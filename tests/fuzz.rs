@@ -42,8 +42,10 @@ struct BudgetAllocator;
 
 static LIVE: AtomicUsize = AtomicUsize::new(0);
 static CURRENT_CASE: AtomicUsize = AtomicUsize::new(usize::MAX);
-/// Cases whose mutated input still loaded as a scene and was rendered: the fuzzer's depth.
-static RENDERED: AtomicUsize = AtomicUsize::new(0);
+/// Per kind of seed: cases run, and cases whose mutated input still loaded as a scene and was
+/// rendered (the fuzzer's depth).
+static CASES: [AtomicUsize; 5] = [const { AtomicUsize::new(0) }; 5];
+static RENDERED: [AtomicUsize; 5] = [const { AtomicUsize::new(0) }; 5];
 
 #[global_allocator]
 static ALLOCATOR: BudgetAllocator = BudgetAllocator;
@@ -429,10 +431,10 @@ fn scene_using(kind: Kind, file: &str) -> String {
 
 /// Load `text` as a scene at `path`; if it loads, render its first 8 x 8 pixels at 1 spp with
 /// every AOV and bake each texture at 8 x 8: every value must be finite.
-fn load_and_render(text: &str, path: &Path) -> Result<(), String> {
+fn load_and_render(text: &str, path: &Path, kind: Kind) -> Result<(), String> {
     let overrides = SceneOverrides { spp: Some(1), ..Default::default() };
     let Ok(scene) = load_scene_str(text, path, &overrides) else { return Ok(()) };
-    RENDERED.fetch_add(1, Ordering::Relaxed);
+    RENDERED[kind as usize].fetch_add(1, Ordering::Relaxed);
     let s = scene.settings;
     let crop = Crop { x0: 0, y0: 0, x1: s.width.min(8), y1: s.height.min(8) };
     let aovs = [Aov::Albedo, Aov::Normal, Aov::Uv, Aov::Footprint];
@@ -455,6 +457,7 @@ fn load_and_render(text: &str, path: &Path) -> Result<(), String> {
 
 /// Run one case: mutate `seed` and read the result every way tessera reads such a file.
 fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
+    CASES[seed.kind as usize].fetch_add(1, Ordering::Relaxed);
     let bytes = match seed.kind {
         Kind::Glb => mutate_glb(rng, &seed.bytes),
         Kind::Scene | Kind::Obj | Kind::Gltf => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
@@ -468,7 +471,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
         // Loaded from the scene's own folder, so that its meshes and textures resolve.
         let text = String::from_utf8_lossy(&bytes);
         std::fs::write(dir.join("input.toml"), text.as_bytes()).unwrap();
-        return load_and_render(&text, &seed.name);
+        return load_and_render(&text, &seed.name, seed.kind);
     }
     let name = seed.name.to_string_lossy();
     let file = dir.join(&*name);
@@ -482,7 +485,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     } else {
         let _ = tessera::image::read_bitmap_raw(&file, ColorSpace::Srgb);
     }
-    load_and_render(&scene_using(seed.kind, &name), &dir.join("scene.toml"))
+    load_and_render(&scene_using(seed.kind, &name), &dir.join("scene.toml"), seed.kind)
 }
 
 #[test]
@@ -543,11 +546,16 @@ fn fuzz_loaders_with_mutated_inputs() {
         }
     }
     worker.join().unwrap();
+    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image"]
+        .iter()
+        .enumerate()
+        .map(|(k, name)| format!("{name} {}/{}", RENDERED[k].load(Ordering::Relaxed), CASES[k].load(Ordering::Relaxed)))
+        .collect();
     println!(
-        "fuzz: {cases} cases from seed {seed} in {:.1} s ({} loaded and rendered), {} failures",
+        "fuzz: {cases} cases from seed {seed} in {:.1} s, {} failures; loaded and rendered per seed kind: {}",
         start.elapsed().as_secs_f64(),
-        RENDERED.load(Ordering::Relaxed),
-        failures.len()
+        failures.len(),
+        per_kind.join(", ")
     );
     assert!(
         failures.is_empty(),

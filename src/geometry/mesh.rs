@@ -196,7 +196,7 @@ impl TriangleMesh {
             return Err(if before == 0 {
                 "the mesh has no triangles".to_string()
             } else {
-                format!("all {before} triangles have zero area")
+                format!("all {before} triangles have zero area (or one beyond the range of 32-bit floats)")
             });
         }
         Ok(cleanup)
