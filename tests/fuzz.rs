@@ -251,13 +251,41 @@ fn mutate_text(rng: &mut Rng, text: &str) -> Vec<u8> {
     bytes
 }
 
+/// Mutate a JSON document (glTF) mostly where it stays valid JSON, so that the mutation
+/// reaches the importer's checks rather than the JSON parser: one to three numbers replaced
+/// by hostile ones that JSON allows; otherwise any text mutation.
+fn mutate_json(rng: &mut Rng, json: &str) -> Vec<u8> {
+    if rng.below(4) == 0 {
+        return mutate_text(rng, json);
+    }
+    let mut text = json.to_string();
+    for _ in 0..1 + rng.below(3) {
+        text = replace_number_from(rng, &text, JSON_NUMBERS);
+    }
+    text.into_bytes()
+}
+
+/// [`NUMBERS`] that JSON can spell.
+const JSON_NUMBERS: &[&str] = &[
+    "0", "-0", "1", "-1", "2", "3", "0.5", "-0.5", "1e-30", "1e30", "-1e30", "1e38", "255", "256", "65535", "65536",
+    "2147483647", "2147483648", "4294967295", "4294967296", "-2147483648", "9007199254740993", "1e300", "100000",
+    "12", "7", "5120", "5121", "5122", "5123", "5125", "5126",
+];
+
 /// `line` with one of its numbers replaced by one of [`NUMBERS`].
 fn replace_number(rng: &mut Rng, line: &str) -> String {
+    replace_number_from(rng, line, NUMBERS)
+}
+
+/// `line` with one of its numbers replaced by one of `numbers`.
+fn replace_number_from(rng: &mut Rng, line: &str, numbers: &[&str]) -> String {
     let bytes = line.as_bytes();
     let mut spans = Vec::new();
     let mut i = 0;
     while i < bytes.len() {
-        if bytes[i].is_ascii_digit() {
+        // A number starts after punctuation or a space, not inside a word or base64 text.
+        let after_word = i > 0 && (bytes[i - 1].is_ascii_alphanumeric() || b"+/_".contains(&bytes[i - 1]));
+        if bytes[i].is_ascii_digit() && !after_word {
             let mut start = i;
             if start > 0 && bytes[start - 1] == b'-' {
                 start -= 1;
@@ -265,7 +293,9 @@ fn replace_number(rng: &mut Rng, line: &str) -> String {
             while i < bytes.len() && (bytes[i].is_ascii_digit() || b".eE+-".contains(&bytes[i])) {
                 i += 1;
             }
-            spans.push((start, i));
+            if i >= bytes.len() || !bytes[i].is_ascii_alphanumeric() {
+                spans.push((start, i));
+            }
         } else {
             i += 1;
         }
@@ -274,7 +304,7 @@ fn replace_number(rng: &mut Rng, line: &str) -> String {
         return line.to_string();
     }
     let (start, end) = *rng.pick(&spans);
-    format!("{}{}{}", &line[..start], rng.pick(NUMBERS), &line[end..])
+    format!("{}{}{}", &line[..start], rng.pick(numbers), &line[end..])
 }
 
 /// A GLB with its JSON chunk mutated as text and the lengths rebuilt, so that the mutation
@@ -289,7 +319,7 @@ fn mutate_glb(rng: &mut Rng, glb: &[u8]) -> Vec<u8> {
     match (rng.below(4), bin.as_mut()) {
         (0, Some(bin)) => mutate_bytes(rng, bin),
         (1, _) => mutate_bytes(rng, &mut json),
-        _ => json = mutate_text(rng, &String::from_utf8_lossy(&json)),
+        _ => json = mutate_json(rng, &String::from_utf8_lossy(&json)),
     }
     while json.len() % 4 != 0 {
         json.push(b' ');
@@ -460,7 +490,8 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     CASES[seed.kind as usize].fetch_add(1, Ordering::Relaxed);
     let bytes = match seed.kind {
         Kind::Glb => mutate_glb(rng, &seed.bytes),
-        Kind::Scene | Kind::Obj | Kind::Gltf => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
+        Kind::Gltf => mutate_json(rng, &String::from_utf8_lossy(&seed.bytes)),
+        Kind::Scene | Kind::Obj => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
         Kind::Image => {
             let mut b = seed.bytes.clone();
             mutate_bytes(rng, &mut b);
