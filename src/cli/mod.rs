@@ -148,12 +148,12 @@ enum Command {
     },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
-        /// Runs per figure (the median is printed).
-        #[arg(long, default_value_t = 5)]
-        runs: usize,
+        /// Runs per figure (the median is printed; at most 1000).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        runs: u32,
         /// Worker threads for the parallel figures (default: 2, the size of the machines
-        /// Mitsuba's reference figures were measured on; 0 = all cores).
-        #[arg(long, default_value_t = 2)]
+        /// Mitsuba's reference figures were measured on; 0 = all cores; at most 1024).
+        #[arg(long, default_value_t = 2, value_parser = thread_count)]
         threads: usize,
         /// Folder of the shipped scenes.
         #[arg(long, default_value = "scenes")]
@@ -229,10 +229,7 @@ pub fn run() -> Result<ExitCode> {
         Command::Deform { mesh, output } => deform::deform(&mesh, &output),
         Command::Analyze { mesh, exemplar, seed, samples } => deform::analyze(&mesh, &exemplar, seed, samples as usize),
         Command::Bench { runs, threads, scenes, only } => {
-            if runs == 0 {
-                return Err(Error::param("--runs", "must be at least 1"));
-            }
-            bench::run(&scenes, runs, threads, &only)?;
+            bench::run(&scenes, runs as usize, threads, &only)?;
             Ok(ExitCode::SUCCESS)
         }
     }
