@@ -260,17 +260,16 @@ fn mutate_json(rng: &mut Rng, json: &str) -> Vec<u8> {
     }
     let mut text = json.to_string();
     for _ in 0..1 + rng.below(3) {
-        text = replace_number_from(rng, &text, JSON_NUMBERS);
+        text = replace_number_from(rng, &text, &json_numbers());
     }
     text.into_bytes()
 }
 
-/// [`NUMBERS`] that JSON can spell.
-const JSON_NUMBERS: &[&str] = &[
-    "0", "-0", "1", "-1", "2", "3", "0.5", "-0.5", "1e-30", "1e30", "-1e30", "1e38", "255", "256", "65535", "65536",
-    "2147483647", "2147483648", "4294967295", "4294967296", "-2147483648", "9007199254740993", "1e300", "100000",
-    "12", "7", "5120", "5121", "5122", "5123", "5125", "5126",
-];
+/// [`NUMBERS`] that JSON can spell, and the glTF component types (valid and not for each use).
+fn json_numbers() -> Vec<&'static str> {
+    let spelled = NUMBERS.iter().copied().filter(|n| n.parse::<f64>().is_ok_and(f64::is_finite));
+    spelled.chain(["5120", "5121", "5122", "5123", "5125", "5126"]).collect()
+}
 
 /// `line` with one of its numbers replaced by one of [`NUMBERS`].
 fn replace_number(rng: &mut Rng, line: &str) -> String {
@@ -460,8 +459,9 @@ fn scene_using(kind: Kind, file: &str) -> String {
 }
 
 /// Load `text` as a scene at `path`; if it loads, render its first 8 x 8 pixels at 1 spp with
-/// every AOV and bake each texture at 8 x 8: every value must be finite.
-fn load_and_render(text: &str, path: &Path, kind: Kind) -> Result<(), String> {
+/// every AOV, bake each texture at 8 x 8 (every value must be finite) and export it for
+/// Mitsuba into `out`.
+fn load_and_render(text: &str, path: &Path, kind: Kind, out: &Path) -> Result<(), String> {
     let overrides = SceneOverrides { spp: Some(1), ..Default::default() };
     let Ok(scene) = load_scene_str(text, path, &overrides) else { return Ok(()) };
     RENDERED[kind as usize].fetch_add(1, Ordering::Relaxed);
@@ -479,6 +479,8 @@ fn load_and_render(text: &str, path: &Path, kind: Kind) -> Result<(), String> {
             .enumerate()
             .map(|(i, t)| (format!("bake of texture {i}"), bake(t, 8, BakeFootprint::Texel))),
     );
+    // The Mitsuba export reads every part of the scene too (a failure is fine, a panic is not).
+    let _ = tessera::scene::export_mitsuba(&scene, &out.join("export"), 8);
     match images.iter().find(|(_, b)| b.non_finite_count() > 0) {
         Some((name, b)) => Err(format!("{} non-finite values in the {name}", b.non_finite_count())),
         None => Ok(()),
@@ -502,7 +504,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
         // Loaded from the scene's own folder, so that its meshes and textures resolve.
         let text = String::from_utf8_lossy(&bytes);
         std::fs::write(dir.join("input.toml"), text.as_bytes()).unwrap();
-        return load_and_render(&text, &seed.name, seed.kind);
+        return load_and_render(&text, &seed.name, seed.kind, dir);
     }
     let name = seed.name.to_string_lossy();
     let file = dir.join(&*name);
@@ -516,7 +518,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     } else {
         let _ = tessera::image::read_bitmap_raw(&file, ColorSpace::Srgb);
     }
-    load_and_render(&scene_using(seed.kind, &name), &dir.join("scene.toml"), seed.kind)
+    load_and_render(&scene_using(seed.kind, &name), &dir.join("scene.toml"), seed.kind, dir)
 }
 
 #[test]
