@@ -10,12 +10,13 @@ use std::path::{Path, PathBuf};
 /// The whole of the regular file `path` if it holds at most `max_bytes` bytes (a limit of
 /// [`crate::limits`]). `what` names the kind of file in the error (`"a mesh file"`).
 pub fn read_bounded(path: &Path, max_bytes: u64, what: &str) -> Result<Vec<u8>> {
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let metadata = file.metadata().map_err(|e| Error::io(path, e))?;
+    // Asked before opening: opening a named pipe waits for a writer, possibly for ever.
+    let metadata = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     let refuse = |msg: String| Error::io(path, std::io::Error::other(msg));
     if !metadata.is_file() {
         return Err(refuse(format!("not a regular file (a folder, device or pipe): {what} must be a file")));
     }
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     if metadata.len() > max_bytes {
         let size = format!("{} bytes", metadata.len());
         return Err(refuse(crate::limits::exceeded(what, size, format!("{max_bytes} bytes"))));
@@ -180,6 +181,12 @@ mod tests {
         assert!(msg.contains("/dev/zero") && msg.contains("not a regular file"), "{msg}");
         let msg = read_bounded(dir.path(), 1 << 20, "a scene file").unwrap_err().to_string();
         assert!(msg.contains("not a regular file"), "{msg}");
+        // A named pipe without a writer: refused, not waited on.
+        let fifo = dir.path().join("fifo");
+        if std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success()) {
+            let msg = read_bounded(&fifo, 1 << 20, "a mesh file").unwrap_err().to_string();
+            assert!(msg.contains("not a regular file"), "{msg}");
+        }
         std::fs::write(&path, b"\xff\xfe").unwrap();
         assert!(read_text_bounded(&path, 10, "a scene file").unwrap_err().to_string().contains("not UTF-8"));
     }
