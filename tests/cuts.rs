@@ -204,26 +204,39 @@ fn eq8_keeps_the_texture_continuous_inside_a_chart() {
 }
 
 #[test]
-fn analyze_prints_the_seam_metric_with_and_without_eq8() {
+fn analyze_reports_the_normalised_seams_with_and_without_eq8_as_json() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tube.obj"), common::obj_text(&tube(0.9, 0.4, 0.0))).unwrap();
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
-        .arg("analyze")
-        .arg(dir.path().join("tube.obj"))
-        .arg("--exemplar")
-        .arg(common::repo().join("scenes/textures/bark.jpg"))
-        .args(["--orientation", "parallels:0,1,0", "--grid", "32"])
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let figure = |label: &str| -> f64 {
-        let at = stdout.find(label).unwrap_or_else(|| panic!("no '{label}' in {stdout}")) + label.len();
-        stdout[at..].split([',', ';', '\n']).next().unwrap().trim().parse().unwrap()
+    let run = |json: bool| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"));
+        command
+            .arg("analyze")
+            .arg(dir.path().join("tube.obj"))
+            .arg("--exemplar")
+            .arg(common::repo().join("scenes/textures/bark.jpg"))
+            .args(["--orientation", "parallels:0,1,0", "--grid", "32"]);
+        if json {
+            command.arg("--json");
+        }
+        let out = command.output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8_lossy(&out.stdout).into_owned()
     };
-    assert!(figure("deformed with Eq. 8 ") < 0.01, "{stdout}");
-    assert!(figure("; deformed ") > 0.4, "{stdout}");
-    assert!(figure("deformed ") < 1.05 && figure("classical ") > 1.2, "distortion: {stdout}");
+    let text = run(false);
+    assert!(text.contains("deformed with Eq. 8") && text.contains("orientation error"), "{text}");
+    let figures: serde_json::Value = serde_json::from_str(&run(true)).unwrap();
+    let number = |path: &[&str]| -> f64 {
+        path.iter().fold(&figures, |v, key| &v[*key]).as_f64().unwrap_or_else(|| panic!("{path:?} in {figures}"))
+    };
+    // Independent sides read about as differently as unrelated points; Eq. 8 closes the seam.
+    assert!(number(&["seams", "deformed_eq8", "normalised"]) < 0.01, "{figures}");
+    let open = number(&["seams", "deformed", "normalised"]);
+    assert!((0.6..1.4).contains(&open), "{figures}");
+    assert!(number(&["distortion_deformed", "mean_anisotropy"]) < 1.05, "{figures}");
+    assert!(number(&["distortion_classical", "mean_anisotropy"]) > 1.2, "{figures}");
+    // The tube is developable and the parallels are its circles: the texture follows them.
+    assert!(number(&["orientation_error", "mean"]) < 1.0, "{figures}");
+    assert_eq!(number(&["uv_overlap"]), 0.0);
 }
 
 #[test]

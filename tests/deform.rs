@@ -248,3 +248,23 @@ fn cli_reads_gltf_meshes_and_their_tangents() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.contains("bare.gltf") && stderr.contains("TANGENT"), "{stderr}");
 }
+
+#[test]
+fn orientation_error_is_zero_where_the_field_is_followed_and_measures_a_turn() {
+    use tessera::deform::analysis::orientation_error;
+    use tessera::texture::MipMap;
+    use tessera::texture::tiling_blending::{Deformation, DeformationField};
+    let mesh = cylinder_strip(1.0);
+    for orientation in [Orientation::Fixed(Vec3::Y), Orientation::Parallels(Vec3::Y)] {
+        let maps = deformation_maps(&mesh, &orientation, 32, 64, 0.25).unwrap();
+        let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
+        let followed = orientation_error(&mesh, &orientation, |uv| field.at(uv)).unwrap();
+        assert!(followed.mean < 0.1 && followed.p95 < 0.2, "{orientation:?}: {followed:?}");
+        // F R(30 degrees) turns the texture's axis by 30 degrees in UV, and the strip is
+        // isometric: by 30 degrees on the surface.
+        let turn = Mat2::from_angle(30f32.to_radians());
+        let turned = orientation_error(&mesh, &orientation, |uv| field.at(uv) * turn).unwrap();
+        assert!((turned.mean - 30.0).abs() < 0.2 && (turned.p95 - 30.0).abs() < 0.3, "{orientation:?}: {turned:?}");
+    }
+    assert!(orientation_error(&mesh, &Orientation::Uv, |_| Mat2::IDENTITY).is_none());
+}

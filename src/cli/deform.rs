@@ -7,14 +7,16 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
-use tessera::deform::{DeformationMaps, Orientation, channel_std, deformation_maps, distortion, seam_metric};
+use tessera::deform::{
+    AnalysisInput, DeformationMaps, Distortion, Orientation, analysis, deformation_maps, distortion,
+};
 use tessera::error::{Error, Result};
 use tessera::files::StagedFolder;
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
 use tessera::limits;
-use tessera::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, Synthesis, Tiling};
-use tessera::texture::{Filter, ImageTexture, MipMap, Texture, TilingBlending};
+use tessera::texture::tiling_blending::{Deformation, DeformationField};
+use tessera::texture::{Filter, ImageTexture, MipMap, Texture};
 
 /// The mesh and the parameters of its deformation field.
 #[derive(Args)]
@@ -42,8 +44,9 @@ pub struct MeshArgs {
 }
 
 impl MeshArgs {
-    /// Load the mesh and derive its maps; also says how long each took.
-    fn maps(&self) -> Result<(TriangleMesh, DeformationMaps, [f64; 2])> {
+    /// Load the mesh and derive its maps, with the orientation field they follow; also says how
+    /// long each took.
+    fn maps(&self) -> Result<(TriangleMesh, DeformationMaps, Orientation, [f64; 2])> {
         if !(self.tile_size > 1e-6 && self.tile_size <= 1e4) {
             return Err(Error::param("--tile-size", format!("{} is not in (1e-6, 1e4] UV units", self.tile_size)));
         }
@@ -84,7 +87,7 @@ impl MeshArgs {
                 maps.cuts.non_manifold
             );
         }
-        Ok((mesh, maps, [loaded, start.elapsed().as_secs_f64() - loaded]))
+        Ok((mesh, maps, orientation, [loaded, start.elapsed().as_secs_f64() - loaded]))
     }
 }
 
@@ -127,10 +130,8 @@ fn f_map_field(maps: &DeformationMaps) -> DeformationField {
     DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))])
 }
 
-/// Print the distortion metric, classical against deformed through `field`.
-fn print_distortion(mesh: &TriangleMesh, field: &DeformationField) {
-    let classical = distortion(mesh, |_| Mat2::IDENTITY);
-    let deformed = distortion(mesh, |uv| field.at(uv));
+/// Print the distortion metric, classical against deformed.
+fn print_distortion(classical: Option<Distortion>, deformed: Option<Distortion>) {
     if let (Some(c), Some(d)) = (classical, deformed) {
         println!(
             "distortion over {} triangles (area-weighted): mean sigma_max/sigma_min classical {:.3}, deformed {:.3}; \
@@ -142,7 +143,7 @@ fn print_distortion(mesh: &TriangleMesh, field: &DeformationField) {
 
 /// `tessera deform`.
 pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
-    let (mesh, maps, [loaded, computed]) = args.maps()?;
+    let (mesh, maps, _, [loaded, computed]) = args.maps()?;
     // All five files or none: a failure halfway leaves the folder as it was.
     let staged = StagedFolder::new(output)?;
     let write_map = |name: &str, map: &tessera::image::Bitmap| {
@@ -157,7 +158,8 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     write_image(&staged.path().join("orientation.png"), &orientation_picture, &[])?;
     write_image(&staged.path().join("cells.png"), &tessera::deform::cut_map_picture(&maps.cut_map), &[])?;
     staged.commit()?;
-    print_distortion(&mesh, &f_map_field(&maps));
+    let field = f_map_field(&maps);
+    print_distortion(distortion(&mesh, |_| Mat2::IDENTITY), distortion(&mesh, |uv| field.at(uv)));
     let res = args.res;
     eprintln!(
         "{}: {} triangles ({} mirrored in UV), grid {g}x{g} ({} samples outside every triangle, filled from the nearest), \
@@ -176,57 +178,73 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// `tessera analyze`.
-pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize) -> Result<ExitCode> {
-    let (mesh, maps, _) = args.maps()?;
+/// `tessera analyze`: the figures of [`tessera::deform::analysis`], as text or JSON.
+pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize, json: bool) -> Result<ExitCode> {
+    let (mesh, maps, orientation, _) = args.maps()?;
     let bitmap = read_bitmap(exemplar_path, ColorSpace::Srgb)?;
-    let spread = channel_std(&bitmap);
     let exemplar = Arc::new(Texture::Image(ImageTexture {
         mipmap: Arc::new(MipMap::new(bitmap)),
         filter: Filter::None,
         scale: glam::Vec2::ONE,
         offset: glam::Vec2::ZERO,
     }));
-    let cut_map = CutMap::new(&maps.cut_map).map_err(|msg| Error::mesh(&args.mesh, msg))?;
-    let texture = |deformation: Option<DeformationField>, cuts: Option<CutMap>| {
-        let synthesis = Synthesis {
-            tiling: Tiling::Hexagonal,
-            tile_size: args.tile_size,
-            seed,
-            deformation,
-            cuts,
-            blend: Blend::Linear,
-            inset: false,
-        };
-        TilingBlending::new(Arc::new(synthesis), exemplar.clone()).map_err(|msg| Error::image(exemplar_path, msg))
+    let input = AnalysisInput {
+        mesh: &mesh,
+        maps: &maps,
+        orientation: &orientation,
+        exemplar,
+        tile_size: args.tile_size,
+        seed,
+        samples,
     };
-    let field = f_map_field(&maps);
-    print_distortion(&mesh, &field);
-    if maps.cuts.edges.is_empty() {
-        println!("seams: the mesh has no UV cuts");
+    let a = tessera::deform::analyze(&input).map_err(|msg| Error::mesh(&args.mesh, msg))?;
+    if json {
+        let text = serde_json::to_string_pretty(&a).map_err(|e| Error::param("--json", e.to_string()))?;
+        println!("{text}");
         return Ok(ExitCode::SUCCESS);
     }
-    // The metric's cost is cut edges x samples: bounded, with fewer samples per edge if need be.
-    let edges = maps.cuts.edges.len();
-    let per_edge = samples.min((limits::MAX_SEAM_SAMPLES / edges).max(1));
-    if per_edge < samples {
-        eprintln!(
-            "note: {edges} cut edges: {per_edge} point pairs per edge (at most {} in all)",
-            limits::MAX_SEAM_SAMPLES
+    print_distortion(a.distortion_classical, a.distortion_deformed);
+    match a.seams {
+        None => println!("seams: the mesh has no UV cuts"),
+        Some(s) => {
+            if a.seam_samples < samples {
+                eprintln!(
+                    "note: {} cut edges: {} point pairs per edge (at most {} in all)",
+                    a.cut_edges,
+                    a.seam_samples,
+                    limits::MAX_SEAM_SAMPLES
+                );
+            }
+            let f = |s: Option<analysis::Seams>| s.map_or("n/a".to_string(), |s| format!("{:.4}", s.normalised));
+            println!(
+                "seams over {} cut edges in {} boundary cells (mean |T_left - T_right| over that of independent point \
+                 pairs; hexagonal tiles of {}, linear blending): classical {}, classical with Eq. 8 {}; deformed {}, \
+                 deformed with Eq. 8 {}",
+                a.cut_edges,
+                a.cells,
+                args.tile_size,
+                f(s.classical),
+                f(s.classical_eq8),
+                f(s.deformed),
+                f(s.deformed_eq8)
+            );
+        }
+    }
+    if let Some(e) = a.orientation_error {
+        println!(
+            "orientation error (the texture's x axis J F^-1 e1 against the orientation field, area-weighted): \
+             mean {:.2} degrees, 95th percentile {:.2} degrees",
+            e.mean, e.p95
         );
     }
-    let seams = |texture: TilingBlending| seam_metric(&maps.cuts, &texture, spread, per_edge).unwrap_or(f64::NAN);
-    let classical = seams(texture(None, None)?);
-    let classical_cells = seams(texture(None, Some(cut_map.clone()))?);
-    let deformed = seams(texture(Some(field.clone()), None)?);
-    let deformed_cells = seams(texture(Some(field), Some(cut_map))?);
     println!(
-        "seams over {} cut edges in {} boundary cells (mean |T_left - T_right| / std(exemplar), hexagonal tiles of {}, \
-         linear blending): classical {classical:.4}, classical with Eq. 8 {classical_cells:.4}; deformed {deformed:.4}, \
-         deformed with Eq. 8 {deformed_cells:.4}",
-        maps.cuts.edges.len(),
-        maps.cuts.cells.len(),
-        args.tile_size
+        "fold-over of the tiles' lookups F(u)(u - c), tile centres {} away: {:.3}% of {} texels fold, {:.3}% stretch \
+         beyond 2:1; UV area covered more than once: {:.3}%",
+        args.tile_size,
+        100.0 * a.fold_over.folded,
+        a.fold_over.texels,
+        100.0 * a.fold_over.stretched,
+        100.0 * a.uv_overlap
     );
     Ok(ExitCode::SUCCESS)
 }

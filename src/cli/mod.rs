@@ -131,8 +131,8 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
-    /// Print the distortion and seam metrics of tiling and blending on a mesh, classical
-    /// against deformed, with and without Eq. 8 at the cuts.
+    /// Print the figures of tiling and blending on a mesh: distortion and seams (classical
+    /// against deformed, with and without Eq. 8 at the cuts), orientation error, fold-over.
     Analyze {
         #[command(flatten)]
         mesh: deform::MeshArgs,
@@ -145,6 +145,9 @@ enum Command {
         /// Point pairs per cut edge for the seam metric.
         #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=4096))]
         samples: u32,
+        /// Print the figures as JSON (for scripts).
+        #[arg(long)]
+        json: bool,
     },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
@@ -227,7 +230,9 @@ pub fn run() -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Deform { mesh, output } => deform::deform(&mesh, &output),
-        Command::Analyze { mesh, exemplar, seed, samples } => deform::analyze(&mesh, &exemplar, seed, samples as usize),
+        Command::Analyze { mesh, exemplar, seed, samples, json } => {
+            deform::analyze(&mesh, &exemplar, seed, samples as usize, json)
+        }
         Command::Bench { runs, threads, scenes, only } => {
             bench::run(&scenes, runs as usize, threads, &only)?;
             Ok(ExitCode::SUCCESS)

@@ -15,6 +15,18 @@ use crate::math::largest_singular_value;
 use glam::{Mat2, Vec2};
 use std::collections::{HashMap, VecDeque};
 
+/// A point of a cut seen from both sides: its UVs on the left and the right side of the cut,
+/// and the surface length it stands for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeamPoint {
+    /// UV on side 0.
+    pub left: Vec2,
+    /// UV on side 1.
+    pub right: Vec2,
+    /// Surface length represented.
+    pub weight: f32,
+}
+
 /// A mesh edge embedded twice in UV: the same two surface points seen from its two faces.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CutEdge {
@@ -320,18 +332,28 @@ impl Cuts {
         map
     }
 
-    /// Mean over the cuts of |T(left) - T(right)|, the mean of `difference` of the texture at
-    /// corresponding points of the two sides: `samples` points per edge, weighted by the
-    /// edges' surface length. None without cut edges.
-    pub fn seam_difference(&self, samples: usize, difference: impl Fn(Vec2, Vec2) -> f32) -> Option<f64> {
-        let (mut sum, mut total) = (0.0f64, 0.0f64);
+    /// Corresponding points of the two sides of every cut edge: `samples` per edge, at the
+    /// middles of equal parts, each weighted by the edge's surface length over `samples`.
+    pub fn seam_points(&self, samples: usize) -> Vec<SeamPoint> {
+        let mut points = Vec::with_capacity(self.edges.len() * samples);
         for edge in &self.edges {
             for s in 0..samples {
                 let t = (s as f32 + 0.5) / samples as f32;
-                let d = difference(edge.point(0, t), edge.point(1, t)) as f64;
-                sum += d * edge.length as f64;
-                total += edge.length as f64;
+                let weight = edge.length / samples as f32;
+                points.push(SeamPoint { left: edge.point(0, t), right: edge.point(1, t), weight });
             }
+        }
+        points
+    }
+
+    /// Mean over the cuts of |T(left) - T(right)|, the mean of `difference` of the texture at
+    /// the [`Cuts::seam_points`], weighted by the edges' surface length. None without cut
+    /// edges.
+    pub fn seam_difference(&self, samples: usize, difference: impl Fn(Vec2, Vec2) -> f32) -> Option<f64> {
+        let (mut sum, mut total) = (0.0f64, 0.0f64);
+        for p in self.seam_points(samples) {
+            sum += difference(p.left, p.right) as f64 * p.weight as f64;
+            total += p.weight as f64;
         }
         (total > 0.0).then(|| sum / total)
     }

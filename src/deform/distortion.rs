@@ -9,7 +9,7 @@ use crate::geometry::TriangleMesh;
 use glam::{Mat2, Vec2};
 
 /// Area-weighted statistics of the composite map's singular values.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Distortion {
     /// Area-weighted mean of sigma_1 / sigma_2 (1 for a conformal map).
     pub mean_anisotropy: f64,

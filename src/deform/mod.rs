@@ -3,6 +3,7 @@
 //! tangent field, the grid smoothing of Eq. 7, and the F map that a tiling-and-blending texture
 //! reads (`deformation = [{ type = "map", ... }]`).
 
+pub mod analysis;
 mod cuts;
 mod distortion;
 mod geodesic;
@@ -12,11 +13,12 @@ mod nearest;
 mod overlap;
 mod seams;
 
-pub use cuts::{BoundaryCell, CutEdge, Cuts};
+pub use analysis::{Analysis, AnalysisInput, analyze};
+pub use cuts::{BoundaryCell, CutEdge, Cuts, SeamPoint};
 pub use distortion::{Distortion, distortion};
 pub use gradient::{TriangleDeformation, deformation_gradient};
 pub use grid::{FieldGrid, FieldSample};
-pub use overlap::{UvOverlap, uv_overlap};
+pub use overlap::{UvOverlap, uv_coverage, uv_overlap};
 pub use seams::{channel_std, seam_metric};
 
 use crate::geometry::TriangleMesh;
@@ -44,7 +46,7 @@ pub enum Orientation {
 impl Orientation {
     /// The direction o on each triangle of `mesh` (not yet projected on its plane); None where
     /// there is none ([`Orientation::Uv`], a vanishing gradient).
-    fn per_triangle(&self, mesh: &TriangleMesh) -> Vec<Option<Vec3>> {
+    pub(crate) fn per_triangle(&self, mesh: &TriangleMesh) -> Vec<Option<Vec3>> {
         let corners = |idx: &[u32; 3]| idx.map(|i| mesh.positions[i as usize]);
         match self {
             Orientation::Uv => vec![None; mesh.indices.len()],

@@ -33,6 +33,16 @@ impl UvOverlap {
 /// or more and twice or more by `triangles` (in UV). Parts of triangles outside the square are
 /// not counted; degenerate triangles cover nothing.
 pub fn uv_overlap(triangles: &[[Vec2; 3]], n: usize) -> UvOverlap {
+    let counts = uv_coverage(triangles, n);
+    UvOverlap {
+        covered: counts.iter().filter(|c| **c >= 1).count(),
+        overlapped: counts.iter().filter(|c| **c >= 2).count(),
+    }
+}
+
+/// How many of `triangles` cover each texel centre of an `n` x `n` grid over the UV square
+/// (row-major, row 0 at v = 0), saturated at 255.
+pub fn uv_coverage(triangles: &[[Vec2; 3]], n: usize) -> Vec<u8> {
     // Per row, +1 where a span starts and -1 just after it ends.
     let mut starts = vec![0i32; n * (n + 1)];
     for t in triangles {
@@ -55,16 +65,15 @@ pub fn uv_overlap(triangles: &[[Vec2; 3]], n: usize) -> UvOverlap {
             }
         }
     }
-    let (mut covered, mut overlapped) = (0, 0);
+    let mut counts = Vec::with_capacity(n * n);
     for row in starts.chunks_exact(n + 1) {
         let mut count = 0;
         for delta in &row[..n] {
             count += delta;
-            covered += usize::from(count >= 1);
-            overlapped += usize::from(count >= 2);
+            counts.push(count.clamp(0, 255) as u8);
         }
     }
-    UvOverlap { covered, overlapped }
+    counts
 }
 
 /// The interval [left, right) of the horizontal line at height `y` inside triangle `t`, from

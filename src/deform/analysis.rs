@@ -1,0 +1,325 @@
+//! The figures `tessera analyze` prints for a UV-mapped mesh and its deformation maps (paper
+//! 000; DESIGN.md sections 5 and 6), computed here so that the tests share them:
+//!
+//! - **seams**, normalised: at corresponding points of the two sides of every cut, the mean of
+//!   |T_left - T_right| divided by the mean of |T(p) - T(q)| over independent point pairs of the
+//!   same synthesis (the cut points paired with those half the list away). 0 is a continuous
+//!   texture, about 1 a cut that shows as much as two unrelated points do; unlike a division by
+//!   the exemplar's spread, this does not depend on the blending's variance or the scale of F.
+//! - **orientation error**: the angle between the texture's x axis on the surface, J F^-1 e1
+//!   (DESIGN.md section 3), and the orientation field, area-weighted mean and 95th percentile.
+//! - **fold-over**: where the lookup u -> F(u)(u - c) of a tile centred at c stops being
+//!   injective (its Jacobian F + dF (u - c) changes the sign of det F) or stretches by more than
+//!   2:1, for tile centres in every direction at a tile's distance (the paper's open "cracks").
+//!   Measured on the F map's texels inside UV triangles.
+//! - **distortion**: [`super::distortion`], classical and deformed.
+
+use super::{Cuts, DeformationMaps, Distortion, Orientation, distortion, uv_coverage};
+use crate::geometry::TriangleMesh;
+use crate::image::Bitmap;
+use crate::limits;
+use crate::math::largest_singular_value;
+use crate::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, Synthesis, Tiling};
+use crate::texture::{MipMap, TexCtx, Texture, TilingBlending};
+use glam::{Mat2, Vec2, Vec3};
+use std::sync::Arc;
+
+/// Seam figures of one synthesis.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Seams {
+    /// mean |T_left - T_right| / mean |T(p) - T(q)| over independent pairs.
+    pub normalised: f64,
+    /// mean |T_left - T_right| averaged over RGB (the numerator).
+    pub mean_difference: f64,
+}
+
+/// Measure the seams of `texture` over `cuts` with `samples` point lookups per cut edge (no
+/// footprint). None without cut edges or for a texture equal at every pair of points.
+pub fn seams(cuts: &Cuts, texture: &TilingBlending, samples: usize) -> Option<Seams> {
+    let at = |uv: Vec2| texture.eval(&TexCtx { uv, ..Default::default() }).truncate();
+    let points = cuts.seam_points(samples);
+    let n = points.len();
+    if n == 0 {
+        return None;
+    }
+    let difference = |a: Vec3, b: Vec3| ((a - b).abs().element_sum() / 3.0) as f64;
+    let values: Vec<(Vec3, Vec3)> = points.iter().map(|p| (at(p.left), at(p.right))).collect();
+    let (mut across, mut independent, mut total) = (0.0, 0.0, 0.0);
+    for (i, (p, (left, right))) in points.iter().zip(&values).enumerate() {
+        let w = p.weight as f64;
+        across += w * difference(*left, *right);
+        independent += w * difference(*left, values[(i + n / 2) % n].1);
+        total += w;
+    }
+    (independent > 0.0).then(|| Seams { normalised: across / independent, mean_difference: across / total })
+}
+
+/// Area-weighted statistics of an angle, in degrees.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct AngleError {
+    /// Mean.
+    pub mean: f64,
+    /// 95th percentile.
+    pub p95: f64,
+}
+
+/// The angle between the texture's x axis on the surface, J F^-1 e1 with F from `f_at` at each
+/// triangle's UV centroid, and the orientation field's direction on each triangle. None for
+/// [`Orientation::Uv`] or where no triangle has both.
+pub fn orientation_error(
+    mesh: &TriangleMesh,
+    orientation: &Orientation,
+    f_at: impl Fn(Vec2) -> Mat2,
+) -> Option<AngleError> {
+    let uvs = mesh.uvs.as_ref()?;
+    let mut angles: Vec<(f64, f64)> = Vec::new();
+    for (idx, direction) in mesh.indices.iter().zip(orientation.per_triangle(mesh)) {
+        let Some(o) = direction else { continue };
+        let x = idx.map(|i| mesh.positions[i as usize]);
+        let u = idx.map(|i| uvs[i as usize]);
+        let Some(j) = super::deformation_gradient(x, u) else { continue };
+        let normal = (x[1] - x[0]).cross(x[2] - x[0]);
+        let f = f_at((u[0] + u[1] + u[2]) / 3.0);
+        if !(f.determinant().abs() > 1e-12) {
+            continue;
+        }
+        let axis_uv = f.inverse() * Vec2::X;
+        let axis = j.x_axis * axis_uv.x + j.y_axis * axis_uv.y;
+        let along = (o - normal * o.dot(normal) / normal.length_squared()).try_normalize();
+        let (Some(along), Some(axis)) = (along, axis.try_normalize()) else { continue };
+        let angle = axis.dot(along).clamp(-1.0, 1.0).acos().to_degrees() as f64;
+        angles.push((angle, normal.length() as f64 / 2.0));
+    }
+    let total: f64 = angles.iter().map(|a| a.1).sum();
+    if !(total > 0.0) {
+        return None;
+    }
+    let mean = angles.iter().map(|(a, w)| a * w).sum::<f64>() / total;
+    angles.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut below = 0.0;
+    let p95 = angles
+        .iter()
+        .find(|(_, w)| {
+            below += w;
+            below >= 0.95 * total
+        })
+        .map_or(0.0, |a| a.0);
+    Some(AngleError { mean, p95 })
+}
+
+/// Where tiles' lookups fold over or stretch.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FoldOver {
+    /// Fraction of the measured texels where a tile's lookup folds (its Jacobian's determinant
+    /// has the opposite sign to det F, or is 0).
+    pub folded: f64,
+    /// Fraction where it stretches by more than 2:1 against F (a singular value of
+    /// (F + dF d) F^-1 above 2 or below 1/2) without folding.
+    pub stretched: f64,
+    /// Texels measured (inside a UV triangle).
+    pub texels: usize,
+}
+
+/// Directions of tile centres tried around each texel.
+const FOLD_DIRECTIONS: usize = 8;
+
+/// The fold-over of the F map `f_map` (4 channels, row 0 at v = 1) for tiles whose centres
+/// lie `reach` UV units away (the tile's support radius), on the texels that `covered` marks
+/// (row-major from the bottom row, as [`super::uv_coverage`] gives them). dF comes from
+/// central differences of neighbouring texels (one-sided at the map's border).
+pub fn fold_over(f_map: &Bitmap, covered: &[u8], reach: f32) -> FoldOver {
+    let res = f_map.width;
+    let f = |i: usize, j: usize| {
+        // j counts rows from the bottom (v up).
+        let t = f_map.values(i, res - 1 - j);
+        Mat2::from_cols(Vec2::new(t[0], t[2]), Vec2::new(t[1], t[3]))
+    };
+    let derivative = |i: usize, j: usize, along_u: bool| {
+        let (lo, hi) = if along_u {
+            ((i.saturating_sub(1), j), ((i + 1).min(res - 1), j))
+        } else {
+            ((i, j.saturating_sub(1)), (i, (j + 1).min(res - 1)))
+        };
+        let span = if along_u { hi.0 - lo.0 } else { hi.1 - lo.1 };
+        if span == 0 { Mat2::ZERO } else { (f(hi.0, hi.1) - f(lo.0, lo.1)) * (res as f32 / span as f32) }
+    };
+    let (mut folded, mut stretched, mut texels) = (0usize, 0usize, 0usize);
+    for j in 0..res {
+        for i in 0..res {
+            if covered[j * res + i] == 0 {
+                continue;
+            }
+            let fu = f(i, j);
+            let det = fu.determinant();
+            if !(det.abs() > 1e-12) {
+                continue;
+            }
+            texels += 1;
+            let (du, dv) = (derivative(i, j, true), derivative(i, j, false));
+            let inverse = fu.inverse();
+            let (mut fold, mut stretch) = (false, false);
+            for k in 0..FOLD_DIRECTIONS {
+                let d = Vec2::from_angle(k as f32 * std::f32::consts::TAU / FOLD_DIRECTIONS as f32) * reach;
+                // d/du_k of F(u)(u - c) = F e_k + (dF/du_k)(u - c), u - c = d.
+                let jacobian = Mat2::from_cols(fu.x_axis + du * d, fu.y_axis + dv * d);
+                if !(jacobian.determinant() / det > 0.0) {
+                    fold = true;
+                    break;
+                }
+                // Singular values of the lookup's change against F's: s_max s_min = |det|.
+                let relative = jacobian * inverse;
+                let s_max = largest_singular_value(relative);
+                stretch |= s_max > 2.0 || relative.determinant().abs() / s_max < 0.5;
+            }
+            folded += usize::from(fold);
+            stretched += usize::from(stretch && !fold);
+        }
+    }
+    let fraction = |n: usize| if texels == 0 { 0.0 } else { n as f64 / texels as f64 };
+    FoldOver { folded: fraction(folded), stretched: fraction(stretched), texels }
+}
+
+/// The seam figures of the four syntheses `tessera analyze` compares.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SeamReport {
+    /// Classical tiling and blending (F = I), no Eq. 8.
+    pub classical: Option<Seams>,
+    /// Classical, with Eq. 8 at the cuts.
+    pub classical_eq8: Option<Seams>,
+    /// Deformed by the F map, no Eq. 8.
+    pub deformed: Option<Seams>,
+    /// Deformed, with Eq. 8.
+    pub deformed_eq8: Option<Seams>,
+}
+
+/// Everything `tessera analyze` reports about a mesh and its maps.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Analysis {
+    /// Triangles of the mesh.
+    pub triangles: usize,
+    /// Cut edges and boundary cells.
+    pub cut_edges: usize,
+    /// Boundary cells of the cuts.
+    pub cells: usize,
+    /// Distortion of the classical texture (F = I).
+    pub distortion_classical: Option<Distortion>,
+    /// Distortion of the deformed texture (the F map).
+    pub distortion_deformed: Option<Distortion>,
+    /// Seams, with the point pairs per cut edge used.
+    pub seams: Option<SeamReport>,
+    /// Point pairs per cut edge of the seam figures.
+    pub seam_samples: usize,
+    /// Angle between the deformed texture's x axis and the orientation field.
+    pub orientation_error: Option<AngleError>,
+    /// Fold-over of the tiles' lookups through the F map.
+    pub fold_over: FoldOver,
+    /// Fraction of the UV area covered more than once.
+    pub uv_overlap: f64,
+}
+
+/// What [`analyze`] measures: a mesh with UVs, the maps `deform` derived from it with its
+/// orientation, and the synthesis the seams are measured on (hexagonal tiles of `tile_size`,
+/// linear blending of `exemplar`, shifts from `seed`).
+pub struct AnalysisInput<'a> {
+    /// The mesh, with UVs.
+    pub mesh: &'a TriangleMesh,
+    /// Its deformation maps.
+    pub maps: &'a DeformationMaps,
+    /// The orientation field the maps were made with.
+    pub orientation: &'a Orientation,
+    /// The exemplar the seams are synthesised from.
+    pub exemplar: Arc<Texture>,
+    /// Lattice spacing of the tiles (UV units).
+    pub tile_size: f32,
+    /// Seed of the tiles' shifts.
+    pub seed: u64,
+    /// Point pairs per cut edge (lowered so that cut edges times samples stays within
+    /// [`limits::MAX_SEAM_SAMPLES`]).
+    pub samples: usize,
+}
+
+/// Measure everything [`Analysis`] holds.
+pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
+    let (mesh, maps) = (input.mesh, input.maps);
+    let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
+    let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
+    let cut_map = CutMap::new(&maps.cut_map)?;
+    let edges = maps.cuts.edges.len();
+    let samples = input.samples.min((limits::MAX_SEAM_SAMPLES / edges.max(1)).max(1));
+    let seams = (edges > 0)
+        .then(|| -> Result<SeamReport, String> {
+            let measure = |deformation: Option<DeformationField>, cuts: Option<CutMap>| {
+                let synthesis = Synthesis {
+                    tiling: Tiling::Hexagonal,
+                    tile_size: input.tile_size,
+                    seed: input.seed,
+                    deformation,
+                    cuts,
+                    blend: Blend::Linear,
+                    inset: false,
+                };
+                Ok::<_, String>(seams(
+                    &maps.cuts,
+                    &TilingBlending::new(Arc::new(synthesis), input.exemplar.clone())?,
+                    samples,
+                ))
+            };
+            Ok(SeamReport {
+                classical: measure(None, None)?,
+                classical_eq8: measure(None, Some(cut_map.clone()))?,
+                deformed: measure(Some(field.clone()), None)?,
+                deformed_eq8: measure(Some(field.clone()), Some(cut_map.clone()))?,
+            })
+        })
+        .transpose()?;
+    let res = maps.f_map.width;
+    let triangles: Vec<[Vec2; 3]> = mesh.indices.iter().map(|t| t.map(|i| uvs[i as usize])).collect();
+    let covered = uv_coverage(&triangles, res);
+    Ok(Analysis {
+        triangles: mesh.indices.len(),
+        cut_edges: edges,
+        cells: maps.cuts.cells.len(),
+        distortion_classical: distortion(mesh, |_| Mat2::IDENTITY),
+        distortion_deformed: distortion(mesh, |uv| field.at(uv)),
+        seams,
+        seam_samples: samples,
+        orientation_error: orientation_error(mesh, input.orientation, |uv| field.at(uv)),
+        // A hexagonal tile reaches one lattice spacing from its centre.
+        fold_over: fold_over(&maps.f_map, &covered, input.tile_size),
+        uv_overlap: maps.overlap.fraction(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An F map of `res` x `res` texels holding F(u) = R(k u) (a rotation turning along u).
+    fn turning_map(res: usize, k: f32) -> Bitmap {
+        let mut map = Bitmap::new(res, res, 4);
+        for (n, px) in map.data.chunks_exact_mut(4).enumerate() {
+            let u = ((n % res) as f32 + 0.5) / res as f32;
+            let (sin, cos) = (k * u).sin_cos();
+            // (F00, F01, F10, F11) of [[cos, -sin], [sin, cos]].
+            px.copy_from_slice(&[cos, -sin, sin, cos]);
+        }
+        map
+    }
+
+    #[test]
+    fn fold_over_is_found_where_the_field_turns_faster_than_a_tile_can_follow() {
+        // The lookup's Jacobian is F + dF/du (u - c) e1^T; relative to F, its determinant is
+        // 1 - k d_v: for tile centres a distance r away it folds once k r > 1.
+        let (res, r) = (64, 0.1);
+        let covered = vec![1u8; res * res];
+        let slow = fold_over(&turning_map(res, 1.0), &covered, r);
+        assert_eq!((slow.folded, slow.stretched, slow.texels), (0.0, 0.0, res * res));
+        let fast = fold_over(&turning_map(res, 30.0), &covered, r);
+        assert!(fast.folded > 0.9, "{fast:?}");
+        // Uncovered texels are not measured.
+        assert_eq!(fold_over(&turning_map(res, 30.0), &vec![0u8; res * res], r).texels, 0);
+        // Between: stretched beyond 2:1 (k r = 0.6 gives a relative determinant of 0.4).
+        let middle = fold_over(&turning_map(res, 6.0), &covered, r);
+        assert!(middle.folded == 0.0 && middle.stretched > 0.9, "{middle:?}");
+    }
+}
