@@ -215,7 +215,15 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
                     limits::MAX_SEAM_SAMPLES
                 );
             }
-            let f = |s: Option<analysis::Seams>| s.map_or("n/a".to_string(), |s| format!("{:.4}", s.normalised));
+            // Ordinary cuts, then UV singularities (pole fans, darts) where the mesh has them.
+            let f = |s: analysis::SeamFigures| {
+                let figure =
+                    |s: Option<analysis::Seams>| s.map_or("n/a".to_string(), |s| format!("{:.4}", s.normalised));
+                match s.singular {
+                    None => figure(s.ordinary),
+                    Some(_) => format!("{} (singular cuts {})", figure(s.ordinary), figure(s.singular)),
+                }
+            };
             println!(
                 "seams over {} cut edges in {} boundary cells (mean |T_left - T_right| over that of independent point \
                  pairs; hexagonal tiles of {}, linear blending): classical {}, classical with Eq. 8 {}; deformed {}, \

@@ -6,6 +6,7 @@
 //!   same synthesis (the cut points paired with those half the list away). 0 is a continuous
 //!   texture, about 1 a cut that shows as much as two unrelated points do; unlike a division by
 //!   the exemplar's spread, this does not depend on the blending's variance or the scale of F.
+//!   Ordinary cuts and UV singularities (pole fans, darts) are reported apart.
 //! - **orientation error**: the angle between the texture's x axis on the surface, J F^-1 e1
 //!   (DESIGN.md section 3), and the orientation field, area-weighted mean and 95th percentile.
 //! - **fold-over**: where the lookup u -> F(u)(u - c) of a tile centred at c stops being
@@ -14,7 +15,7 @@
 //!   Measured on the F map's texels inside UV triangles.
 //! - **distortion**: [`super::distortion`], classical and deformed.
 
-use super::{Cuts, DeformationMaps, Distortion, Orientation, distortion, uv_coverage};
+use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion, uv_coverage};
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
@@ -33,15 +34,31 @@ pub struct Seams {
     pub mean_difference: f64,
 }
 
+/// The seams of one synthesis, apart for ordinary cuts and for UV singularities (pole fans,
+/// darts: [`super::CutEdge::is_singular`]), whose texture the paper's Sec. 5 does not address.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct SeamFigures {
+    /// Over the ordinary cut edges; None if there are none.
+    pub ordinary: Option<Seams>,
+    /// Over the singular cut edges; None if there are none.
+    pub singular: Option<Seams>,
+}
+
 /// Measure the seams of `texture` over `cuts` with `samples` point lookups per cut edge (no
-/// footprint). None without cut edges or for a texture equal at every pair of points.
-pub fn seams(cuts: &Cuts, texture: &TilingBlending, samples: usize) -> Option<Seams> {
+/// footprint).
+pub fn seams(cuts: &Cuts, texture: &TilingBlending, samples: usize) -> SeamFigures {
     let at = |uv: Vec2| texture.eval(&TexCtx { uv, ..Default::default() }).truncate();
     let points = cuts.seam_points(samples);
+    let of = |singular: bool| {
+        let points: Vec<&SeamPoint> = points.iter().filter(|p| p.singular == singular).collect();
+        seams_at(&points, at)
+    };
+    SeamFigures { ordinary: of(false), singular: of(true) }
+}
+
+/// The seam figures over `points`; None without points or for a texture equal at every pair.
+fn seams_at(points: &[&SeamPoint], at: impl Fn(Vec2) -> Vec3) -> Option<Seams> {
     let n = points.len();
-    if n == 0 {
-        return None;
-    }
     let difference = |a: Vec3, b: Vec3| ((a - b).abs().element_sum() / 3.0) as f64;
     let values: Vec<(Vec3, Vec3)> = points.iter().map(|p| (at(p.left), at(p.right))).collect();
     let (mut across, mut independent, mut total) = (0.0, 0.0, 0.0);
@@ -51,7 +68,7 @@ pub fn seams(cuts: &Cuts, texture: &TilingBlending, samples: usize) -> Option<Se
         independent += w * difference(*left, values[(i + n / 2) % n].1);
         total += w;
     }
-    (independent > 0.0).then(|| Seams { normalised: across / independent, mean_difference: across / total })
+    (n > 0 && independent > 0.0).then(|| Seams { normalised: across / independent, mean_difference: across / total })
 }
 
 /// Area-weighted statistics of an angle, in degrees.
@@ -183,13 +200,13 @@ pub fn fold_over(f_map: &Bitmap, covered: &[u8], reach: f32) -> FoldOver {
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SeamReport {
     /// Classical tiling and blending (F = I), no Eq. 8.
-    pub classical: Option<Seams>,
+    pub classical: SeamFigures,
     /// Classical, with Eq. 8 at the cuts.
-    pub classical_eq8: Option<Seams>,
+    pub classical_eq8: SeamFigures,
     /// Deformed by the F map, no Eq. 8.
-    pub deformed: Option<Seams>,
+    pub deformed: SeamFigures,
     /// Deformed, with Eq. 8.
-    pub deformed_eq8: Option<Seams>,
+    pub deformed_eq8: SeamFigures,
 }
 
 /// Everything `tessera analyze` reports about a mesh and its maps.

@@ -25,6 +25,8 @@ pub struct SeamPoint {
     pub right: Vec2,
     /// Surface length represented.
     pub weight: f32,
+    /// Whether its edge is a UV singularity ([`CutEdge::is_singular`]).
+    pub singular: bool,
 }
 
 /// A mesh edge embedded twice in UV: the same two surface points seen from its two faces.
@@ -43,6 +45,13 @@ impl CutEdge {
     /// left, 1 right): corresponding parameters are the same surface point on both sides.
     pub fn point(&self, side: usize, t: f32) -> Vec2 {
         self.sides[side][0].lerp(self.sides[side][1], t)
+    }
+
+    /// Whether the two sides meet at one end: the edge opens a dart or a fan from a point
+    /// that both faces map to the same UV, as the triangles around a lat-long sphere's pole do
+    /// (a UV singularity), rather than running along a seam whose sides are apart throughout.
+    pub fn is_singular(&self) -> bool {
+        (0..2).any(|k| self.sides[0][k].distance_squared(self.sides[1][k]) < 1e-12)
     }
 
     fn uv_at(&self, side: usize, vertex: u32) -> Vec2 {
@@ -340,7 +349,8 @@ impl Cuts {
             for s in 0..samples {
                 let t = (s as f32 + 0.5) / samples as f32;
                 let weight = edge.length / samples as f32;
-                points.push(SeamPoint { left: edge.point(0, t), right: edge.point(1, t), weight });
+                let singular = edge.is_singular();
+                points.push(SeamPoint { left: edge.point(0, t), right: edge.point(1, t), weight, singular });
             }
         }
         points
