@@ -23,6 +23,13 @@ fn error_of(toml: &str, files: &[(&str, &[u8])], needles: &[&str]) -> String {
     msg
 }
 
+/// `image` encoded as PNG.
+fn png(image: impl Into<image::DynamicImage>) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    image.into().write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).unwrap();
+    bytes
+}
+
 fn obj_scene(file: &str) -> String {
     format!("{CAMERA}[[shapes]]\ntype = \"obj\"\nfilename = \"{file}\"\n")
 }
@@ -235,13 +242,7 @@ fn cli_renders_crop_and_aovs() {
 
 #[test]
 fn bad_tiling_and_blending_textures_are_named() {
-    let png = {
-        let mut bytes = Vec::new();
-        image::GrayImage::from_pixel(4, 4, image::Luma([90]))
-            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-            .unwrap();
-        bytes
-    };
+    let png = png(image::GrayImage::from_pixel(4, 4, image::Luma([90])));
     let three_channel_exr = {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("f.exr");
@@ -342,13 +343,7 @@ fn cli_bake_names_unknown_textures_and_writes_images() {
             "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
              [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n"
         ),
-        &[("e.png", &{
-            let mut bytes = Vec::new();
-            image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))
-                .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-                .unwrap();
-            bytes
-        })],
+        &[("e.png", &png(image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))))],
     );
     let scene = dir.path().join("scene.toml");
     let missing = tessera()
@@ -394,47 +389,39 @@ fn gltf_documents_the_gltf_crate_would_panic_on_are_errors() {
     // The unedited document loads.
     let dir = scene_dir(&scene, &[("m.glb", &edited_glb(|j| j))]);
     load(dir.path()).expect("the small glTF loads");
-    fails(edited_glb(swap("\"POSITION\": 0", "\"POSITION\": 99")), &["m.glb", "POSITION is accessor 99"]);
-    fails(edited_glb(swap("\"NORMAL\": 1", "\"NORMAL\": 99")), &["m.glb", "malformed glTF"]);
-    fails(
-        edited_glb(swap(
+    // (text replaced, its replacement, what the error must say besides the file's name)
+    let cases: &[(&str, &str, &[&str])] = &[
+        ("\"POSITION\": 0", "\"POSITION\": 99", &["POSITION is accessor 99"]),
+        ("\"NORMAL\": 1", "\"NORMAL\": 99", &["malformed glTF"]),
+        (
             "\"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\"",
             "\"componentType\": 5121, \"count\": 4, \"type\": \"VEC3\", \"min\"",
-        )),
-        &["m.glb", "accessor 0", "allows"],
-    );
-    fails(
-        edited_glb(swap("\"componentType\": 5123, \"count\": 6", "\"componentType\": 5126, \"count\": 6")),
-        &["m.glb", "indices", "allows"],
-    );
-    fails(
-        edited_glb(swap("\"count\": 4, \"type\": \"VEC2\"", "\"count\": 0, \"type\": \"VEC2\"")),
-        &["m.glb", "TexCoords(0)", "0 values"],
-    );
-    fails(
-        edited_glb(swap("\"count\": 6, \"type\": \"SCALAR\"", "\"count\": 600, \"type\": \"SCALAR\"")),
-        &["m.glb", "reaches past the end"],
-    );
-    fails(
-        edited_glb(swap(
+            &["accessor 0", "allows"],
+        ),
+        ("\"componentType\": 5123, \"count\": 6", "\"componentType\": 5126, \"count\": 6", &["indices", "allows"]),
+        ("\"count\": 4, \"type\": \"VEC2\"", "\"count\": 0, \"type\": \"VEC2\"", &["TexCoords(0)", "0 values"]),
+        ("\"count\": 6, \"type\": \"SCALAR\"", "\"count\": 600, \"type\": \"SCALAR\"", &["reaches past the end"]),
+        (
             "\"byteOffset\": 0, \"byteLength\": 48",
             "\"byteOffset\": 0, \"byteLength\": 48, \"byteStride\": 4",
-        )),
-        &["m.glb", "byteStride 4"],
-    );
-    fails(
-        edited_glb(swap("\"byteOffset\": 48, \"byteLength\": 48", "\"byteOffset\": 48, \"byteLength\": 4800")),
-        &["m.glb", "past the end of buffer 0"],
-    );
-    fails(edited_glb(swap("{\"mesh\": 0,", "{\"children\": [0], \"mesh\": 0,")), &["m.glb", "cycle"]);
-    fails(edited_glb(swap("{\"camera\": 0,", "{\"children\": [1], \"camera\": 0,")), &["m.glb", "child of both"]);
-    fails(
-        edited_glb(swap(
+            &["byteStride 4"],
+        ),
+        (
+            "\"byteOffset\": 48, \"byteLength\": 48",
+            "\"byteOffset\": 48, \"byteLength\": 4800",
+            &["past the end of buffer 0"],
+        ),
+        ("{\"mesh\": 0,", "{\"children\": [0], \"mesh\": 0,", &["cycle"]),
+        ("{\"camera\": 0,", "{\"children\": [1], \"camera\": 0,", &["child of both"]),
+        (
             "\"count\": 4, \"type\": \"VEC2\"}",
             "\"count\": 4, \"type\": \"VEC2\", \"sparse\": {\"count\": 1, \"indices\": {\"bufferView\": 4, \"componentType\": 5123}, \"values\": {\"bufferView\": 2}}}",
-        )),
-        &["m.glb", "sparse"],
-    );
+            &["sparse"],
+        ),
+    ];
+    for (from, to, needles) in cases {
+        fails(edited_glb(swap(from, to)), &[&["m.glb"], *needles].concat());
+    }
     // Images: without bufferView or uri; with a bufferView past the buffer. Without a mimeType
     // the format is read from the data, which works.
     let msg = error_of(
@@ -497,13 +484,7 @@ fn sizes_from_files_and_flags_are_limited_before_allocation() {
         &["shapes[0]", "134217728", "limit"],
     );
     // Tiling and blending nested four deep: each level triples the cost of every lookup.
-    let png = {
-        let mut bytes = Vec::new();
-        image::GrayImage::from_pixel(4, 4, image::Luma([90]))
-            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-            .unwrap();
-        bytes
-    };
+    let png = png(image::GrayImage::from_pixel(4, 4, image::Luma([90])));
     let chain = |depth: usize| {
         let mut toml = format!("{CAMERA}[textures.t0]\ntype = \"image\"\nfilename = \"e.png\"\n");
         for i in 1..=depth {
@@ -557,13 +538,7 @@ fn non_finite_values_never_reach_an_output() {
     error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\nemission = 1e30\n"), &[], &["emission", "1e15"]);
     // A scale field of 2^1000 at u = 1, and a bright emitter: the bake, the AOVs and the
     // variance stay finite.
-    let exemplar = {
-        let mut bytes = Vec::new();
-        image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))
-            .write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png)
-            .unwrap();
-        bytes
-    };
+    let exemplar = png(image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100])));
     let toml = format!(
         "{CAMERA}[render]\nwidth = 12\nheight = 12\nspp = 4\n[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\nfilter = \"ewa\"\n\
          [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\ndeformation = [{{ type = \"scale\", scale = 1, gradient = [1000, 0] }}]\n\
