@@ -72,12 +72,13 @@ impl MeshArgs {
                 maps.degenerate
             );
         }
-        if maps.overlap.overlapped > 0 {
+        let overlap = maps.overlap();
+        if overlap.overlapped > 0 {
             eprintln!(
                 "warning: {}: {:.2}% of the UV area is covered by more than one triangle (overlapping UV islands): \
                  the F map holds one deformation per texel, so those parts of the surface share one",
                 self.mesh.display(),
-                100.0 * maps.overlap.fraction()
+                100.0 * overlap.fraction()
             );
         }
         if maps.cuts.non_manifold > 0 {

@@ -356,7 +356,7 @@ fn diff(
     max_flip: Option<f64>,
     output: Option<&Path>,
 ) -> Result<ExitCode> {
-    use tessera::image::{ColorSpace, compare, read_bitmap, read_bitmap_raw};
+    use tessera::image::{ColorSpace, compare, read_bitmap_raw};
     if variance.is_none() && max_relmse.is_none() && max_flip.is_none() {
         return Err(Error::param(
             "diff",
@@ -365,13 +365,16 @@ fn diff(
     }
     // NaN or infinity in the test image is a failure, never a value to compare (read as 0 it
     // would pass against black); in the reference or its variance it is an error.
-    let t = read_bitmap_raw(test, ColorSpace::Linear)?;
+    let mut t = read_bitmap_raw(test, ColorSpace::Linear)?;
     let invalid = t.non_finite_count();
-    let t = read_bitmap(test, ColorSpace::Linear)?;
+    t.zero_negative_and_non_finite();
     let finite = |path: &Path| -> Result<tessera::image::Bitmap> {
-        let image = read_bitmap_raw(path, ColorSpace::Linear)?;
+        let mut image = read_bitmap_raw(path, ColorSpace::Linear)?;
         match image.non_finite_count() {
-            0 => read_bitmap(path, ColorSpace::Linear),
+            0 => {
+                image.zero_negative_and_non_finite();
+                Ok(image)
+            }
             n => Err(Error::image(path, format!("{n} values are NaN or infinite: not usable as a reference"))),
         }
     };

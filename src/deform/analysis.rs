@@ -15,7 +15,7 @@
 //!   Measured on the F map's texels inside UV triangles.
 //! - **distortion**: [`super::distortion`], classical and deformed.
 
-use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion, uv_coverage};
+use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion};
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
@@ -142,7 +142,8 @@ const FOLD_DIRECTIONS: usize = 8;
 
 /// The fold-over of the F map `f_map` (4 channels, row 0 at v = 1) for tiles whose centres
 /// lie `reach` UV units away (the tile's support radius), on the texels that `covered` marks
-/// (row-major from the bottom row, as [`super::uv_coverage`] gives them). dF comes from
+/// (row-major from the bottom row, as [`super::uv_coverage`] and [`DeformationMaps::coverage`]
+/// give them). dF comes from
 /// central differences of neighbouring texels (one-sided at the map's border).
 pub fn fold_over(f_map: &Bitmap, covered: &[u8], reach: f32) -> FoldOver {
     let res = f_map.width;
@@ -258,7 +259,7 @@ pub struct AnalysisInput<'a> {
 /// Measure everything [`Analysis`] holds.
 pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
     let (mesh, maps) = (input.mesh, input.maps);
-    let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
+    mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
     let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
     let cut_map = CutMap::new(&maps.cut_map)?;
     let edges = maps.cuts.edges.len();
@@ -289,9 +290,6 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
             })
         })
         .transpose()?;
-    let res = maps.f_map.width;
-    let triangles: Vec<[Vec2; 3]> = mesh.indices.iter().map(|t| t.map(|i| uvs[i as usize])).collect();
-    let covered = uv_coverage(&triangles, res);
     Ok(Analysis {
         triangles: mesh.indices.len(),
         cut_edges: edges,
@@ -302,8 +300,8 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
         seam_samples: samples,
         orientation_error: orientation_error(mesh, input.orientation, |uv| field.at(uv)),
         // A hexagonal tile reaches one lattice spacing from its centre.
-        fold_over: fold_over(&maps.f_map, &covered, input.tile_size),
-        uv_overlap: maps.overlap.fraction(),
+        fold_over: fold_over(&maps.f_map, &maps.coverage, input.tile_size),
+        uv_overlap: maps.overlap().fraction(),
     })
 }
 

@@ -346,10 +346,9 @@ impl Cuts {
     pub fn seam_points(&self, samples: usize) -> Vec<SeamPoint> {
         let mut points = Vec::with_capacity(self.edges.len() * samples);
         for edge in &self.edges {
+            let (weight, singular) = (edge.length / samples as f32, edge.is_singular());
             for s in 0..samples {
                 let t = (s as f32 + 0.5) / samples as f32;
-                let weight = edge.length / samples as f32;
-                let singular = edge.is_singular();
                 points.push(SeamPoint { left: edge.point(0, t), right: edge.point(1, t), weight, singular });
             }
         }

@@ -92,8 +92,16 @@ pub struct DeformationMaps {
     pub degenerate: usize,
     /// Triangles whose UVs are mirrored (R is a reflection there).
     pub mirrored: usize,
+    /// How many UV triangles cover each texel centre of the maps ([`uv_coverage`]; row 0 at
+    /// v = 0).
+    pub coverage: Vec<u8>,
+}
+
+impl DeformationMaps {
     /// How much of the UV square more than one triangle covers, at the maps' resolution.
-    pub overlap: UvOverlap,
+    pub fn overlap(&self) -> UvOverlap {
+        UvOverlap::of_coverage(&self.coverage)
+    }
 }
 
 /// Derive the deformation field of `mesh` (which must have UVs): F = R(theta) S per triangle,
@@ -161,10 +169,10 @@ pub fn deformation_maps(
             px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
         }
     }
-    let overlap = uv_overlap(&uv_triangles, res);
+    let coverage = uv_coverage(&uv_triangles, res);
     let cuts = Cuts::new(mesh, 2.0 * tile_size);
     let cut_map = cuts.cut_map(&f_map, std::f32::consts::SQRT_2 * tile_size);
-    Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored, overlap })
+    Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored, coverage })
 }
 
 /// Pictures of an F map for people to look at: log2 |det F| as grey (0.5 at 1, black at 1/16,

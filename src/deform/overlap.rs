@@ -22,6 +22,14 @@ pub struct UvOverlap {
 }
 
 impl UvOverlap {
+    /// The counts of a coverage grid ([`uv_coverage`]).
+    pub fn of_coverage(coverage: &[u8]) -> Self {
+        UvOverlap {
+            covered: coverage.iter().filter(|c| **c >= 1).count(),
+            overlapped: coverage.iter().filter(|c| **c >= 2).count(),
+        }
+    }
+
     /// The fraction of the covered texels that are covered more than once (0 when none is
     /// covered).
     pub fn fraction(&self) -> f64 {
@@ -33,11 +41,7 @@ impl UvOverlap {
 /// or more and twice or more by `triangles` (in UV). Parts of triangles outside the square are
 /// not counted; degenerate triangles cover nothing.
 pub fn uv_overlap(triangles: &[[Vec2; 3]], n: usize) -> UvOverlap {
-    let counts = uv_coverage(triangles, n);
-    UvOverlap {
-        covered: counts.iter().filter(|c| **c >= 1).count(),
-        overlapped: counts.iter().filter(|c| **c >= 2).count(),
-    }
+    UvOverlap::of_coverage(&uv_coverage(triangles, n))
 }
 
 /// How many of `triangles` cover each texel centre of an `n` x `n` grid over the UV square

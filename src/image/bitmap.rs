@@ -59,6 +59,16 @@ impl Bitmap {
         &mut self.data[i..i + self.channels]
     }
 
+    /// Set negative values (lossy EXR compression) and non-finite ones to 0: what colours and
+    /// radiance read from a file become ([`super::read_bitmap`]).
+    pub fn zero_negative_and_non_finite(&mut self) {
+        for v in &mut self.data {
+            if !(v.is_finite() && *v >= 0.0) {
+                *v = 0.0;
+            }
+        }
+    }
+
     /// Number of NaN or infinite values.
     pub fn non_finite_count(&self) -> usize {
         self.data.iter().filter(|v| !v.is_finite()).count()

@@ -34,11 +34,7 @@ impl OutputFormat {
 /// (lossy EXR compression) and non-finite ones become 0.
 pub fn read_bitmap(path: &Path, space: ColorSpace) -> Result<Bitmap> {
     let mut bitmap = read_bitmap_raw(path, space)?;
-    for v in &mut bitmap.data {
-        if !(v.is_finite() && *v >= 0.0) {
-            *v = 0.0;
-        }
-    }
+    bitmap.zero_negative_and_non_finite();
     Ok(bitmap)
 }
 

@@ -42,10 +42,10 @@ fn read_gltf(path: &Path) -> Result<GltfFile> {
     guard_parser(path, || {
         let malformed = |e: gltf::Error| Error::mesh(path, format!("malformed glTF: {e}"));
         // gltf-json's own validation indexes the accessors by each POSITION attribute before it
-        // checks the index: check those first.
-        let unchecked = gltf::Gltf::from_slice_without_validation(&bytes).map_err(malformed)?;
-        check_position_accessors(unchecked.document.as_json()).map_err(|msg| Error::mesh(path, msg))?;
-        let gltf::Gltf { document: doc, mut blob } = gltf::Gltf::from_slice(&bytes).map_err(malformed)?;
+        // checks the index: check those first, then validate.
+        let gltf::Gltf { document, mut blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(malformed)?;
+        check_position_accessors(document.as_json()).map_err(|msg| Error::mesh(path, msg))?;
+        let doc = gltf::Document::from_json(document.into_json()).map_err(malformed)?;
         check_node_tree(&doc).map_err(|msg| Error::mesh(path, msg))?;
         let mut buffers = Vec::new();
         for buffer in doc.buffers() {
