@@ -60,8 +60,13 @@ pub const MAX_BAKE_RES: u32 = 8192;
 /// at the peak with the pictures.
 pub const MAX_DEFORM_RES: u32 = 4096;
 
-/// Largest side of `tessera deform`'s smoothing grid (`--grid`).
-pub const MAX_DEFORM_GRID: u32 = 4096;
+/// Most rounds of `tessera deform`'s per-chart smoothing (`--smoothing`): each is one pass over
+/// the triangles, so that the largest mesh takes minutes, not hours.
+pub const MAX_DEFORM_SMOOTHING: u32 = 256;
+
+/// Largest cuts file (`cuts = "cuts.json"`, written by `tessera deform`): a few hundred
+/// thousand cut edges.
+pub const MAX_CUTS_FILE_BYTES: u64 = 64 << 20;
 
 /// Most point pairs `tessera analyze` evaluates per seam metric (cut edges times samples per
 /// edge): the samples per edge are lowered to fit.

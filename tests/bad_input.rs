@@ -264,17 +264,28 @@ fn bad_tiling_and_blending_textures_are_named() {
         tessera::image::write_exr(&p, 2, 2, channels).unwrap();
         std::fs::read(&p).unwrap()
     };
-    // A cut map whose cell channel holds 2.5, not a cell number.
-    let fractional_cell_exr = {
+    // An identity F map, for cuts files.
+    let identity_exr = {
         let dir = tempfile::tempdir().unwrap();
-        let p = dir.path().join("c.exr");
-        let planes = [vec![2.5f32, 0.0, 0.0, 0.0], vec![0.5; 4], vec![0.5; 4], vec![1.0; 4]];
+        let p = dir.path().join("i.exr");
+        let planes = [vec![1.0f32; 4], vec![0.0; 4], vec![0.0; 4], vec![1.0; 4]];
         let channels = ["R", "G", "B", "A"].iter().zip(planes).map(|(c, p)| (c.to_string(), p)).collect();
         tessera::image::write_exr(&p, 2, 2, channels).unwrap();
         std::fs::read(&p).unwrap()
     };
-    let files: &[(&str, &[u8])] =
-        &[("e.png", &png), ("f.exr", &three_channel_exr), ("n.exr", &nan_exr), ("c.exr", &fractional_cell_exr)];
+    let point = |s: &str| format!("[0.5, 0.1, 0.5, 0.9, {s}, 0, 0]");
+    let cuts =
+        |a: &str, b: &str| format!("{{\"curves\": [{{\"scale\": 1, \"points\": [{}, {}]}}]}}", point(a), point(b));
+    let (decreasing, overflowing) = (cuts("1", "0"), cuts("0", "1e39"));
+    let files: &[(&str, &[u8])] = &[
+        ("e.png", &png),
+        ("f.exr", &three_channel_exr),
+        ("n.exr", &nan_exr),
+        ("i.exr", &identity_exr),
+        ("dec.json", decreasing.as_bytes()),
+        ("big.json", overflowing.as_bytes()),
+        ("bad.json", b"{\"curves\": 3}"),
+    ];
     let with = |tb: &str, extra: &str| {
         format!(
             "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n{extra}\
@@ -312,9 +323,17 @@ fn bad_tiling_and_blending_textures_are_named() {
         files,
         &["n.exr", "NaN", "textures.tb.deformation[0]"],
     );
-    error_of(&with("exemplar = \"e\"\ncuts = \"f.exr\"", ""), files, &["f.exr", "4 channels", "textures.tb.cuts"]);
-    error_of(&with("exemplar = \"e\"\ncuts = \"n.exr\"", ""), files, &["n.exr", "NaN", "textures.tb.cuts"]);
-    error_of(&with("exemplar = \"e\"\ncuts = \"c.exr\"", ""), files, &["c.exr", "2.5", "textures.tb.cuts"]);
+    error_of(&with("exemplar = \"e\"\ncuts = \"dec.json\"", ""), files, &["textures.tb.cuts", "map factor"]);
+    let mapped = |cuts: &str| {
+        with(
+            &format!("exemplar = \"e\"\ndeformation = [{{ type = \"map\", filename = \"i.exr\" }}]\ncuts = \"{cuts}\""),
+            "",
+        )
+    };
+    error_of(&mapped("dec.json"), files, &["dec.json", "decreases", "textures.tb.cuts"]);
+    error_of(&mapped("big.json"), files, &["big.json", "not finite", "textures.tb.cuts"]);
+    error_of(&mapped("bad.json"), files, &["bad.json", "not a cuts file", "textures.tb.cuts"]);
+    error_of(&mapped("none.json"), files, &["none.json", "textures.tb.cuts"]);
     error_of(
         &with("exemplar = \"e\"\ndeformation = [{ type = \"map\", filename = \"none.exr\" }]", ""),
         files,

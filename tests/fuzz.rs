@@ -512,7 +512,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     if matches!(seed.kind, Kind::Obj | Kind::Gltf | Kind::Glb) {
         if let Ok((mesh, _)) = load_surface(&file) {
             if mesh.uvs.is_some() {
-                let _ = deformation_maps(&mesh, &Orientation::Uv, 16, 32, 0.25);
+                let _ = deformation_maps(&mesh, &Orientation::Uv, 1, 32, 0.25);
             }
         }
     } else {

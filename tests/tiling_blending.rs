@@ -330,8 +330,8 @@ fn footprint_is_f_times_the_pixel_footprint_as_finite_differences_say() {
             let uv = Sampler::new(2, i, 0).next_2d() * 4.0;
             let d = (Sampler::new(3, i, 0).next_2d() - 0.5) * 1e-3;
             let ctx = TexCtx { uv, duv_dx: d, duv_dy: d.perp() };
-            let here = s.lookups(&ctx);
-            let there = s.lookups(&TexCtx { uv: uv + d, ..ctx });
+            let (here, _) = s.lookups(&ctx);
+            let (there, _) = s.lookups(&TexCtx { uv: uv + d, ..ctx });
             let f = s.deformation_at(uv);
             let df = s.deformation_at(uv + d) - f;
             let tiles = s.tiling.tiles(uv, s.tile_size);
@@ -514,7 +514,7 @@ fn inset_shifts_keep_tiles_inside_a_non_tileable_exemplar() {
         let mut hi = Vec2::ZERO;
         for i in 0..20_000 {
             let uv = Sampler::new(4, i, 0).next_2d() * 10.0 - 5.0;
-            for l in s.lookups(&TexCtx { uv, ..Default::default() }).iter().take(s.tiles_per_point()) {
+            for l in s.lookups(&TexCtx { uv, ..Default::default() }).0.iter().take(s.tiles_per_point()) {
                 lo = lo.min(l.ctx.uv);
                 hi = hi.max(l.ctx.uv);
             }

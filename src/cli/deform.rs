@@ -15,7 +15,7 @@ use tessera::files::StagedFolder;
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
 use tessera::limits;
-use tessera::texture::tiling_blending::{Deformation, DeformationField};
+use tessera::texture::tiling_blending::{Deformation, DeformationField, cuts_to_json};
 use tessera::texture::{Filter, ImageTexture, MipMap, Texture};
 
 /// The mesh and the parameters of its deformation field.
@@ -24,9 +24,10 @@ pub struct MeshArgs {
     /// The mesh with texture coordinates: OBJ, or glTF 2.0 (.gltf, .glb; all its triangle
     /// primitives in world space).
     mesh: PathBuf,
-    /// Vertices per side of the smoothing grid over the UV square (Eq. 7; at most 4096).
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_DEFORM_GRID as i64))]
-    grid: u32,
+    /// Rounds of averaging of the field over each UV vertex's triangles, within its chart
+    /// (Sec. 4.4; 0 keeps each vertex the mean of its triangles; at most 256).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=limits::MAX_DEFORM_SMOOTHING as i64))]
+    smoothing: u32,
     /// Texels per side of the F map and the cut map (at most 4096).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_DEFORM_RES as i64))]
     res: u32,
@@ -37,8 +38,8 @@ pub struct MeshArgs {
     /// file's TANGENT attribute).
     #[arg(long, default_value = "uv")]
     orientation: String,
-    /// Lattice spacing of the tiles in UV units (the scene's `tile_size`): boundary cells are
-    /// merged until longer than a tile on both sides of the cut.
+    /// Lattice spacing of the tiles in UV units (the scene's `tile_size`): the width of the
+    /// cut bands pictured and analysed (the renderer lays them for the scene's own).
     #[arg(long, default_value_t = 0.25)]
     tile_size: f32,
 }
@@ -63,11 +64,11 @@ impl MeshArgs {
             }
             (text, _) => parse_orientation(text)?,
         };
-        let maps = deformation_maps(&mesh, &orientation, self.grid as usize, self.res as usize, self.tile_size)
+        let maps = deformation_maps(&mesh, &orientation, self.smoothing as usize, self.res as usize, self.tile_size)
             .map_err(|msg| Error::mesh(&self.mesh, msg))?;
         if maps.degenerate > 0 {
             eprintln!(
-                "warning: {}: {} triangles are degenerate in 3D or in UV; their grid samples take the nearest triangle's values",
+                "warning: {}: {} triangles are degenerate in 3D or in UV; their corners take their neighbours' values",
                 self.mesh.display(),
                 maps.degenerate
             );
@@ -153,28 +154,31 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         write_exr(&staged.path().join(name), map.width, map.height, channels)
     };
     write_map("f_map.exr", &maps.f_map)?;
-    write_map("cut_map.exr", &maps.cut_map)?;
+    let cuts_file = staged.path().join("cuts.json");
+    std::fs::write(&cuts_file, cuts_to_json(maps.bands.curves())).map_err(|e| Error::io(&cuts_file, e))?;
     let (det, orientation_picture) = tessera::deform::f_map_pictures(&maps.f_map);
     write_image(&staged.path().join("det_f.png"), &det, &[])?;
     write_image(&staged.path().join("orientation.png"), &orientation_picture, &[])?;
-    write_image(&staged.path().join("cells.png"), &tessera::deform::cut_map_picture(&maps.cut_map), &[])?;
+    write_image(&staged.path().join("cut_bands.png"), &tessera::deform::bands_picture(&maps.bands, &maps.f_map), &[])?;
     staged.commit()?;
     let field = f_map_field(&maps);
     print_distortion(distortion(&mesh, |_| Mat2::IDENTITY), distortion(&mesh, |uv| field.at(uv)));
     let res = args.res;
     eprintln!(
-        "{}: {} triangles ({} mirrored in UV), grid {g}x{g} ({} samples outside every triangle, filled from the nearest), \
-         {} cut edges in {} boundary cells (tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
-         wrote f_map.exr, cut_map.exr, det_f.png, orientation.png, cells.png to {}",
+        "{}: {} triangles ({} mirrored in UV) in {} charts, {} rounds of smoothing ({} texels outside every triangle, \
+         extrapolated from the nearest), \
+         {} cut edges in {} cuts (bands for tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
+         wrote f_map.exr, cuts.json, det_f.png, orientation.png, cut_bands.png to {}",
         args.mesh.display(),
         mesh.indices.len(),
         maps.mirrored,
-        maps.grid.filled,
+        maps.field.charts,
+        args.smoothing,
+        maps.raster.filled,
         maps.cuts.edges.len(),
-        maps.cuts.cells.len(),
+        maps.cuts.chains.len(),
         args.tile_size,
         output.display(),
-        g = args.grid,
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -226,16 +230,14 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
                 }
             };
             println!(
-                "seams over {} cut edges in {} boundary cells (mean |T_left - T_right| over that of independent point \
-                 pairs; hexagonal tiles of {}, linear blending): classical {}, classical with Eq. 8 {}; deformed {}, \
-                 deformed with Eq. 8 {}",
+                "seams over {} cut edges in {} cuts (mean |T_left - T_right| over that of independent point pairs; \
+                 hexagonal tiles of {}, linear blending): classical {}; deformed {}, deformed with cut bands {}",
                 a.cut_edges,
-                a.cells,
+                a.cuts,
                 args.tile_size,
                 f(s.classical),
-                f(s.classical_eq8),
                 f(s.deformed),
-                f(s.deformed_eq8)
+                f(s.deformed_bands)
             );
         }
     }

@@ -121,9 +121,9 @@ enum Command {
         #[arg(long, default_value = "texel")]
         footprint: FootprintArg,
     },
-    /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and its UV cuts'
-    /// boundary cells (Sec. 5): writes f_map.exr (F00, F01, F10, F11), cut_map.exr (cell + 1,
-    /// b.x, b.y, reach) and pictures of |det F|, the orientation and the cells.
+    /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and its UV cuts:
+    /// writes f_map.exr (F00, F01, F10, F11), cuts.json (the cut curves the synthesis' cut
+    /// bands follow) and pictures of |det F|, the orientation and the cut bands.
     Deform {
         #[command(flatten)]
         mesh: deform::MeshArgs,
@@ -132,7 +132,7 @@ enum Command {
         output: PathBuf,
     },
     /// Print the figures of tiling and blending on a mesh: distortion and seams (classical
-    /// against deformed, with and without Eq. 8 at the cuts), orientation error, fold-over.
+    /// against deformed, with and without cut bands), orientation error, fold-over.
     Analyze {
         #[command(flatten)]
         mesh: deform::MeshArgs,

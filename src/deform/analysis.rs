@@ -20,7 +20,7 @@ use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
 use crate::math::largest_singular_value;
-use crate::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, Synthesis, Tiling};
+use crate::texture::tiling_blending::{Blend, CutBands, Deformation, DeformationField, Synthesis, Tiling};
 use crate::texture::{MipMap, TexCtx, Texture, TilingBlending};
 use glam::{Mat2, Vec2, Vec3};
 use std::sync::Arc;
@@ -143,9 +143,10 @@ const FOLD_DIRECTIONS: usize = 8;
 /// The fold-over of the F map `f_map` (4 channels, row 0 at v = 1) for tiles whose centres
 /// lie `reach` UV units away (the tile's support radius), on the texels that `covered` marks
 /// (row-major from the bottom row, as [`super::uv_coverage`] and [`DeformationMaps::coverage`]
-/// give them). dF comes from
-/// central differences of neighbouring texels (one-sided at the map's border).
-pub fn fold_over(f_map: &Bitmap, covered: &[u8], reach: f32) -> FoldOver {
+/// give them). dF comes from central differences of neighbouring texels of the same chart
+/// (`chart`, row-major from the bottom row; one-sided at a chart's or the map's border), since
+/// a tile never reads across charts.
+pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32) -> FoldOver {
     let res = f_map.width;
     let f = |i: usize, j: usize| {
         // j counts rows from the bottom (v up).
@@ -153,11 +154,18 @@ pub fn fold_over(f_map: &Bitmap, covered: &[u8], reach: f32) -> FoldOver {
         Mat2::from_cols(Vec2::new(t[0], t[2]), Vec2::new(t[1], t[3]))
     };
     let derivative = |i: usize, j: usize, along_u: bool| {
-        let (lo, hi) = if along_u {
+        let same = |(a, b): (usize, usize)| chart[b * res + a] == chart[j * res + i];
+        let (mut lo, mut hi) = if along_u {
             ((i.saturating_sub(1), j), ((i + 1).min(res - 1), j))
         } else {
             ((i, j.saturating_sub(1)), (i, (j + 1).min(res - 1)))
         };
+        if !same(lo) {
+            lo = (i, j);
+        }
+        if !same(hi) {
+            hi = (i, j);
+        }
         let span = if along_u { hi.0 - lo.0 } else { hi.1 - lo.1 };
         if span == 0 { Mat2::ZERO } else { (f(hi.0, hi.1) - f(lo.0, lo.1)) * (res as f32 / span as f32) }
     };
@@ -197,17 +205,15 @@ pub fn fold_over(f_map: &Bitmap, covered: &[u8], reach: f32) -> FoldOver {
     FoldOver { folded: fraction(folded), stretched: fraction(stretched), texels }
 }
 
-/// The seam figures of the four syntheses `tessera analyze` compares.
+/// The seam figures of the three syntheses `tessera analyze` compares.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SeamReport {
-    /// Classical tiling and blending (F = I), no Eq. 8.
+    /// Classical tiling and blending (F = I).
     pub classical: SeamFigures,
-    /// Classical, with Eq. 8 at the cuts.
-    pub classical_eq8: SeamFigures,
-    /// Deformed by the F map, no Eq. 8.
+    /// Deformed by the F map, cuts left alone.
     pub deformed: SeamFigures,
-    /// Deformed, with Eq. 8.
-    pub deformed_eq8: SeamFigures,
+    /// Deformed, with cut bands ([`CutBands`]).
+    pub deformed_bands: SeamFigures,
 }
 
 /// Everything `tessera analyze` reports about a mesh and its maps.
@@ -215,10 +221,10 @@ pub struct SeamReport {
 pub struct Analysis {
     /// Triangles of the mesh.
     pub triangles: usize,
-    /// Cut edges and boundary cells.
+    /// Cut edges.
     pub cut_edges: usize,
-    /// Boundary cells of the cuts.
-    pub cells: usize,
+    /// Cuts (chains of cut edges).
+    pub cuts: usize,
     /// Distortion of the classical texture (F = I).
     pub distortion_classical: Option<Distortion>,
     /// Distortion of the deformed texture (the F map).
@@ -261,12 +267,11 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
     let (mesh, maps) = (input.mesh, input.maps);
     mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
     let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
-    let cut_map = CutMap::new(&maps.cut_map)?;
     let edges = maps.cuts.edges.len();
     let samples = input.samples.min((limits::MAX_SEAM_SAMPLES / edges.max(1)).max(1));
     let seams = (edges > 0)
         .then(|| -> Result<SeamReport, String> {
-            let measure = |deformation: Option<DeformationField>, cuts: Option<CutMap>| {
+            let measure = |deformation: Option<DeformationField>, cuts: Option<CutBands>| {
                 let synthesis = Synthesis {
                     tiling: Tiling::Hexagonal,
                     tile_size: input.tile_size,
@@ -284,23 +289,22 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
             };
             Ok(SeamReport {
                 classical: measure(None, None)?,
-                classical_eq8: measure(None, Some(cut_map.clone()))?,
                 deformed: measure(Some(field.clone()), None)?,
-                deformed_eq8: measure(Some(field.clone()), Some(cut_map.clone()))?,
+                deformed_bands: measure(Some(field.clone()), Some(maps.bands.clone()))?,
             })
         })
         .transpose()?;
     Ok(Analysis {
         triangles: mesh.indices.len(),
         cut_edges: edges,
-        cells: maps.cuts.cells.len(),
+        cuts: maps.cuts.chains.len(),
         distortion_classical: distortion(mesh, |_| Mat2::IDENTITY),
         distortion_deformed: distortion(mesh, |uv| field.at(uv)),
         seams,
         seam_samples: samples,
         orientation_error: orientation_error(mesh, input.orientation, |uv| field.at(uv)),
         // A hexagonal tile reaches one lattice spacing from its centre.
-        fold_over: fold_over(&maps.f_map, &maps.coverage, input.tile_size),
+        fold_over: fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), input.tile_size),
         uv_overlap: maps.overlap().fraction(),
     })
 }
@@ -327,14 +331,18 @@ mod tests {
         // 1 - k d_v: for tile centres a distance r away it folds once k r > 1.
         let (res, r) = (64, 0.1);
         let covered = vec![1u8; res * res];
-        let slow = fold_over(&turning_map(res, 1.0), &covered, r);
+        let one_chart = vec![0u32; res * res];
+        let slow = fold_over(&turning_map(res, 1.0), &covered, &one_chart, r);
         assert_eq!((slow.folded, slow.stretched, slow.texels), (0.0, 0.0, res * res));
-        let fast = fold_over(&turning_map(res, 30.0), &covered, r);
+        let fast = fold_over(&turning_map(res, 30.0), &covered, &one_chart, r);
         assert!(fast.folded > 0.9, "{fast:?}");
         // Uncovered texels are not measured.
-        assert_eq!(fold_over(&turning_map(res, 30.0), &vec![0u8; res * res], r).texels, 0);
+        assert_eq!(fold_over(&turning_map(res, 30.0), &vec![0u8; res * res], &one_chart, r).texels, 0);
+        // Every texel its own chart: no neighbour to differentiate with, nothing folds.
+        let apart: Vec<u32> = (0..(res * res) as u32).collect();
+        assert_eq!(fold_over(&turning_map(res, 30.0), &covered, &apart, r).folded, 0.0);
         // Between: stretched beyond 2:1 (k r = 0.6 gives a relative determinant of 0.4).
-        let middle = fold_over(&turning_map(res, 6.0), &covered, r);
+        let middle = fold_over(&turning_map(res, 6.0), &covered, &one_chart, r);
         assert!(middle.folded == 0.0 && middle.stretched > 0.9, "{middle:?}");
     }
 }

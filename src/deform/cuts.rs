@@ -1,19 +1,19 @@
-//! UV cuts and their boundary cells (paper 000 Sec. 5; DESIGN.md section 6).
+//! UV cuts (paper 000 Sec. 5; DESIGN.md section 6): the mesh edges the UV map embeds twice,
+//! chained into cuts, and the cut curves the synthesis' cut bands follow.
 //!
 //! A cut edge is a mesh edge whose two faces give its endpoints different UVs: it is embedded
-//! twice in the UV plane, a left and a right copy. Consecutive cut edges are merged breadth-first
-//! into boundary cells until a cell is longer than a tile on both sides; each cell keeps the
-//! midpoints b_l and b'_l of its most central edge on the two sides. The cut map stores, per
-//! texel of the UV square, the cell whose band holds it and that side's centre, so that the
-//! tiling-and-blending lookup can give every tile centred in the cell the same centre and shift
-//! on both sides (Eq. 8).
+//! twice in the UV plane, a left and a right copy. Consecutive cut edges (the cut goes on
+//! through their shared vertex with the same two UVs) are chained into cuts, their sides made
+//! consistent along each; a cut ends where its two sides meet or where three charts meet.
+//! Along each cut, the arc length s and the developed exemplar coordinate g (g' = F t, the mean
+//! of the two sides' F) are integrated edge by edge: the shared coordinates of
+//! [`crate::texture::tiling_blending::CutBands`].
 
-use super::nearest::{NONE, clamped_pieces, distance2_to_segment, propagate_nearest};
+use super::field::{ChartField, barycentric};
 use crate::geometry::TriangleMesh;
-use crate::image::Bitmap;
-use crate::math::largest_singular_value;
-use glam::{Mat2, Vec2};
-use std::collections::{HashMap, VecDeque};
+use crate::texture::tiling_blending::{CutCurve, CutPoint};
+use glam::Vec2;
+use std::collections::HashMap;
 
 /// A point of a cut seen from both sides: its UVs on the left and the right side of the cut,
 /// and the surface length it stands for.
@@ -36,6 +36,8 @@ pub struct CutEdge {
     pub sides: [[Vec2; 2]; 2],
     /// The position-welded vertex ids of the endpoints.
     pub vertices: [u32; 2],
+    /// The triangle on each side.
+    pub faces: [u32; 2],
     /// Length on the surface.
     pub length: f32,
 }
@@ -58,10 +60,6 @@ impl CutEdge {
         self.sides[side][usize::from(self.vertices[1] == vertex)]
     }
 
-    fn side_length(&self, side: usize) -> f32 {
-        self.sides[side][0].distance(self.sides[side][1])
-    }
-
     /// How `other` continues this edge through their shared `vertex`: Some(false) with the same
     /// left and right, Some(true) with the sides swapped, None when it is not the same cut
     /// (its UVs at the vertex differ, or the cut ends there: both sides meet).
@@ -81,42 +79,29 @@ impl CutEdge {
     }
 }
 
-/// A boundary cell: consecutive cut edges, embedded on a left and a right side.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BoundaryCell {
-    /// b_l and b'_l: the midpoints, on the left and on the right, of the cell's most central
-    /// edge (the same surface point).
-    pub centres: [Vec2; 2],
-    /// The cell's length in UV on each side.
-    pub lengths: [f32; 2],
-}
-
-/// The cut edges of a mesh grouped into boundary cells.
+/// The cut edges of a mesh chained into cuts.
 #[derive(Clone, Debug, Default)]
 pub struct Cuts {
-    /// Cut edges, each with `sides[0]` on its cell's left.
+    /// Cut edges, each with `sides` consistent along its chain.
     pub edges: Vec<CutEdge>,
-    /// The cell of each edge.
-    pub cell_of_edge: Vec<u32>,
-    /// The cells.
-    pub cells: Vec<BoundaryCell>,
+    /// The cuts: their edges in order along each, with whether each is walked from its second
+    /// vertex to its first.
+    pub chains: Vec<Vec<(u32, bool)>>,
     /// Edges with more than two faces, left out.
     pub non_manifold: usize,
 }
 
 impl Cuts {
-    /// The cut edges of `mesh` (which must have UVs), merged breadth-first along the cuts into
-    /// cells longer than `min_length` in UV on both sides where the cut is long enough (Sec. 5,
-    /// steps 1-3).
-    pub fn new(mesh: &TriangleMesh, min_length: f32) -> Self {
+    /// The cut edges of `mesh` (which must have UVs), chained into cuts (Sec. 5, steps 1-2).
+    pub fn new(mesh: &TriangleMesh) -> Self {
         let Some(uvs) = &mesh.uvs else { return Cuts::default() };
         let (welded, points) = mesh.welded_vertices();
         // The UVs each face gives each welded edge (lower vertex id first), edges in order of
         // first appearance.
         let mut index: HashMap<(u32, u32), usize> = HashMap::new();
         let mut keys: Vec<(u32, u32)> = Vec::new();
-        let mut faces: Vec<Vec<[Vec2; 2]>> = Vec::new();
-        for tri in &mesh.indices {
+        let mut faces: Vec<Vec<([Vec2; 2], u32)>> = Vec::new();
+        for (t, tri) in mesh.indices.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
                 let (wa, wb) = (welded[a as usize], welded[b as usize]);
@@ -133,25 +118,25 @@ impl Cuts {
                     faces.push(Vec::new());
                     faces.len() - 1
                 });
-                faces[slot].push(uv);
+                faces[slot].push((uv, t as u32));
             }
         }
         let mut non_manifold = 0;
         let mut edges = Vec::new();
         for ((a, b), uv) in keys.into_iter().zip(faces) {
             match uv.as_slice() {
-                [left, right]
+                [(left, f0), (right, f1)]
                     if left[0].distance_squared(right[0]) > 1e-12 || left[1].distance_squared(right[1]) > 1e-12 =>
                 {
                     let length = points[a as usize].distance(points[b as usize]);
-                    edges.push(CutEdge { sides: [*left, *right], vertices: [a, b], length });
+                    edges.push(CutEdge { sides: [*left, *right], vertices: [a, b], faces: [*f0, *f1], length });
                 }
                 [_, _, _, ..] => non_manifold += 1,
                 _ => {}
             }
         }
-        let mut cuts = Cuts { edges, cell_of_edge: Vec::new(), cells: Vec::new(), non_manifold };
-        cuts.merge_cells(min_length);
+        let mut cuts = Cuts { edges, chains: Vec::new(), non_manifold };
+        cuts.chain();
         cuts
     }
 
@@ -166,179 +151,93 @@ impl Cuts {
         at
     }
 
-    /// The edges that continue edge `e`'s cut, with whether their sides are swapped relative to
-    /// `e`'s.
-    fn neighbours<'a>(&'a self, at: &'a HashMap<u32, Vec<u32>>, e: u32) -> impl Iterator<Item = (u32, bool)> + 'a {
-        let edge = self.edges[e as usize];
-        edge.vertices.into_iter().flat_map(move |v| {
-            at[&v]
-                .iter()
-                .filter(move |&&f| f != e)
-                .filter_map(move |&f| edge.continued_by(&self.edges[f as usize], v).map(|swapped| (f, swapped)))
-        })
-    }
-
-    /// Sec. 5 step 2 and 3: breadth-first merging, sides made consistent within each cell, small
-    /// leftovers merged into a neighbouring cell, the most central edge's midpoints kept.
-    fn merge_cells(&mut self, min_length: f32) {
+    /// Chain consecutive edges into cuts, swapping sides so that they agree along each.
+    fn chain(&mut self) {
         let at = self.edges_at_vertices();
-        let n = self.edges.len();
-        let mut cell_of = vec![NONE; n];
-        let mut members: Vec<Vec<u32>> = Vec::new();
-        let mut lengths: Vec<[f32; 2]> = Vec::new();
-        for start in 0..n as u32 {
-            if cell_of[start as usize] != NONE {
+        let mut used = vec![false; self.edges.len()];
+        for start in 0..self.edges.len() as u32 {
+            if used[start as usize] {
                 continue;
             }
-            let cell = members.len() as u32;
-            let (mut list, mut length) = (Vec::new(), [0.0f32; 2]);
-            let mut queue = VecDeque::from([start]);
-            cell_of[start as usize] = cell;
-            while let Some(e) = queue.pop_front() {
-                list.push(e);
-                length[0] += self.edges[e as usize].side_length(0);
-                length[1] += self.edges[e as usize].side_length(1);
-                if length[0] > min_length && length[1] > min_length {
-                    // Large enough: edges already queued stay in this cell.
-                    list.extend(queue.drain(..));
-                    break;
-                }
-                let next: Vec<(u32, bool)> = self.neighbours(&at, e).collect();
-                for (f, swapped) in next {
-                    if cell_of[f as usize] == NONE {
-                        if swapped {
-                            self.edges[f as usize].sides.swap(0, 1);
-                        }
-                        cell_of[f as usize] = cell;
-                        queue.push_back(f);
-                    }
-                }
-            }
-            // Recounted: the queued edges joined the cell too.
-            let length = list.iter().fold([0.0f32; 2], |l, &e| {
-                let edge = &self.edges[e as usize];
-                [l[0] + edge.side_length(0), l[1] + edge.side_length(1)]
-            });
-            members.push(list);
-            lengths.push(length);
+            used[start as usize] = true;
+            let [first, second] = self.edges[start as usize].vertices;
+            // Walk on from the start edge's second vertex, then (reversed) from its first.
+            let ahead = self.walk(&at, &mut used, start, second);
+            let behind = self.walk(&at, &mut used, start, first);
+            let mut chain: Vec<(u32, bool)> = behind.into_iter().rev().map(|(e, reversed)| (e, !reversed)).collect();
+            chain.push((start, false));
+            chain.extend(ahead);
+            self.chains.push(chain);
         }
-        // Cells that stayed short (the end of a cut) join a neighbouring cell.
-        for cell in 0..members.len() {
-            if members[cell].is_empty() || lengths[cell][0].min(lengths[cell][1]) > min_length {
-                continue;
-            }
-            let join = members[cell]
-                .iter()
-                .find_map(|&e| self.neighbours(&at, e).find(|&(f, _)| cell_of[f as usize] != cell as u32));
-            let Some((f, swapped)) = join else { continue };
-            let target = cell_of[f as usize] as usize;
-            let moved = std::mem::take(&mut members[cell]);
-            for &e in &moved {
-                if swapped {
-                    self.edges[e as usize].sides.swap(0, 1);
-                }
-                cell_of[e as usize] = target as u32;
-            }
-            members[target].extend(moved);
-            let [left, right] = lengths[cell];
-            let added = if swapped { [right, left] } else { [left, right] };
-            lengths[target] = [lengths[target][0] + added[0], lengths[target][1] + added[1]];
-        }
-        // Compact the ids and keep each cell's most central edge.
-        let mut renumber = vec![NONE; members.len()];
-        for (cell, list) in members.iter().enumerate() {
-            if list.is_empty() {
-                continue;
-            }
-            renumber[cell] = self.cells.len() as u32;
-            let midpoints = |e: u32| [0, 1].map(|side| self.edges[e as usize].point(side, 0.5));
-            let mut centroid = [Vec2::ZERO; 2];
-            let mut weight = [0.0f32; 2];
-            for &e in list {
-                for side in 0..2 {
-                    let l = self.edges[e as usize].side_length(side).max(1e-12);
-                    centroid[side] += midpoints(e)[side] * l;
-                    weight[side] += l;
-                }
-            }
-            let centroid = [centroid[0] / weight[0], centroid[1] / weight[1]];
-            let spread = |e: u32| {
-                let m = midpoints(e);
-                m[0].distance_squared(centroid[0]) + m[1].distance_squared(centroid[1])
-            };
-            let central = list.iter().copied().min_by(|&a, &b| spread(a).total_cmp(&spread(b))).expect("non-empty");
-            self.cells.push(BoundaryCell { centres: midpoints(central), lengths: lengths[cell] });
-        }
-        self.cell_of_edge = cell_of.iter().map(|&c| renumber[c as usize]).collect();
     }
 
-    /// The cut map over the UV square at the resolution of the square `f_map` it goes with
-    /// (row 0 at the top, v = 1, as image textures are laid out; DESIGN.md section 6): each
-    /// texel within `band` (UV units, at least a tile's support radius) of a cut edge's copy
-    /// takes the cell of the nearest copy: channels (l + 1, b.x, b.y, reach) with b that side's
-    /// centre and reach how far from b a tile of the cell reads in the exemplar through the F
-    /// map, on either side: the largest sigma_max(F(c)) (|c - b| + `band`) over the cell's
-    /// texels c, for shifts that keep the tiles inside the exemplar. Texels outside every band
-    /// hold 0.
-    pub fn cut_map(&self, f_map: &Bitmap, band: f32) -> Bitmap {
-        let res = f_map.width;
-        let f_at = |i: usize, j: usize| {
-            let f = f_map.values(i, res - 1 - j);
-            Mat2::from_cols(Vec2::new(f[0], f[2]), Vec2::new(f[1], f[3]))
-        };
-        let point = |i: usize, j: usize| Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
-        let segment = |id: u32| self.edges[id as usize / 2].sides[id as usize % 2];
-        let mut owner = vec![NONE; res * res];
-        let mut best = vec![f32::INFINITY; res * res];
-        // Seed the texels each copy passes through; a copy on or beyond the square's border
-        // seeds the border texels nearest to it.
-        let last = (res - 1) as f32;
-        for id in 0..2 * self.edges.len() as u32 {
-            let [a, b] = segment(id);
-            // Step along the copy as the map sees it, clamped to the square: a few steps per
-            // texel of that path, however long the copy is in UV (UVs far outside the square
-            // would otherwise take millions of steps per edge).
-            for [p0, q0] in clamped_pieces(a, b) {
-                let steps = (p0.distance(q0) * res as f32 * 2.0).ceil() as usize + 1;
-                for s in 0..=steps {
-                    let p = (p0.lerp(q0, s as f32 / steps as f32) * res as f32).floor();
-                    if !p.is_finite() {
-                        continue;
-                    }
-                    let (i, j) = (p.x.clamp(0.0, last) as usize, p.y.clamp(0.0, last) as usize);
-                    let d = distance2_to_segment(point(i, j), a, b);
-                    if d < best[j * res + i] {
-                        best[j * res + i] = d;
-                        owner[j * res + i] = id;
-                    }
+    /// The edges continuing edge `from`'s cut through `vertex`, in order, each with whether it
+    /// is walked from its second vertex to its first; their sides are swapped to agree.
+    fn walk(&mut self, at: &HashMap<u32, Vec<u32>>, used: &mut [bool], from: u32, vertex: u32) -> Vec<(u32, bool)> {
+        let (mut current, mut vertex, mut out) = (from, vertex, Vec::new());
+        loop {
+            let edge = self.edges[current as usize];
+            let next = at[&vertex]
+                .iter()
+                .filter(|&&f| !used[f as usize])
+                .find_map(|&f| edge.continued_by(&self.edges[f as usize], vertex).map(|swapped| (f, swapped)));
+            let Some((f, swapped)) = next else { return out };
+            used[f as usize] = true;
+            let next_edge = &mut self.edges[f as usize];
+            if swapped {
+                next_edge.sides.swap(0, 1);
+                next_edge.faces.swap(0, 1);
+            }
+            let reversed = next_edge.vertices[1] == vertex;
+            vertex = next_edge.vertices[usize::from(!reversed)];
+            out.push((f, reversed));
+            current = f;
+        }
+    }
+
+    /// The cut curves of the chains for the field `field` of the mesh whose UV triangles are
+    /// `uv_triangles`: at each chain vertex its UVs on both sides, the arc length s and the
+    /// developed coordinate g, integrated edge by edge as the mean of F dt on the two sides (F
+    /// at each side's edge midpoint, in its face); the scale is the chain's length in map units
+    /// over its mean length in UV. Chains of zero length are left out, and so are chains of
+    /// singular edges only (the fans around a lat-long pole: each edge a cut of its own whose
+    /// band, through F's vanishing stretch along the pole's row, would cover the whole row).
+    pub fn curves(&self, field: &ChartField, uv_triangles: &[[Vec2; 3]]) -> Vec<CutCurve> {
+        let mut curves = Vec::with_capacity(self.chains.len());
+        for chain in &self.chains {
+            if chain.iter().all(|&(e, _)| self.edges[e as usize].is_singular()) {
+                continue;
+            }
+            let mut points = Vec::with_capacity(chain.len() + 1);
+            let (mut s, mut g, mut uv_length) = (0.0f32, Vec2::ZERO, 0.0f32);
+            for (n, &(e, reversed)) in chain.iter().enumerate() {
+                let edge = &self.edges[e as usize];
+                let ends = |side: usize| {
+                    let [a, b] = edge.sides[side];
+                    if reversed { [b, a] } else { [a, b] }
+                };
+                let (left, right) = (ends(0), ends(1));
+                if n == 0 {
+                    points.push(CutPoint { uv: [left[0], right[0]], s, g });
+                }
+                let step = |side: usize, [p, q]: [Vec2; 2]| {
+                    let t = edge.faces[side] as usize;
+                    let b = barycentric((p + q) / 2.0, uv_triangles[t]).unwrap_or(glam::Vec3::ONE);
+                    field.at(t, b) * (q - p)
+                };
+                let dg = (step(0, left) + step(1, right)) / 2.0;
+                g += dg;
+                s += dg.length();
+                uv_length += (left[0].distance(left[1]) + right[0].distance(right[1])) / 2.0;
+                points.push(CutPoint { uv: [left[1], right[1]], s, g });
+            }
+            if s > 0.0 && uv_length > 0.0 {
+                if let Ok(curve) = CutCurve::new(points, s / uv_length) {
+                    curves.push(curve);
                 }
             }
         }
-        propagate_nearest(res, &mut owner, &mut best, |i, j, id| {
-            let [a, b] = segment(id);
-            distance2_to_segment(point(i, j), a, b)
-        });
-        // Each band texel's cell and centre, then each cell's reach over its texels.
-        let in_band = |k: usize| {
-            (owner[k] != NONE && best[k] <= band * band).then(|| {
-                let cell = self.cell_of_edge[owner[k] as usize / 2] as usize;
-                (cell, self.cells[cell].centres[owner[k] as usize % 2])
-            })
-        };
-        let mut reach = vec![0.0f32; self.cells.len()];
-        for k in 0..res * res {
-            if let Some((cell, b)) = in_band(k) {
-                let (i, j) = (k % res, k / res);
-                reach[cell] = reach[cell].max(largest_singular_value(f_at(i, j)) * (point(i, j).distance(b) + band));
-            }
-        }
-        let mut map = Bitmap::new(res, res, 4);
-        for k in 0..res * res {
-            if let Some((cell, b)) = in_band(k) {
-                map.values_mut(k % res, res - 1 - k / res).copy_from_slice(&[(cell + 1) as f32, b.x, b.y, reach[cell]]);
-            }
-        }
-        map
+        curves
     }
 
     /// Corresponding points of the two sides of every cut edge: `samples` per edge, at the
@@ -353,17 +252,5 @@ impl Cuts {
             }
         }
         points
-    }
-
-    /// Mean over the cuts of |T(left) - T(right)|, the mean of `difference` of the texture at
-    /// the [`Cuts::seam_points`], weighted by the edges' surface length. None without cut
-    /// edges.
-    pub fn seam_difference(&self, samples: usize, difference: impl Fn(Vec2, Vec2) -> f32) -> Option<f64> {
-        let (mut sum, mut total) = (0.0f64, 0.0f64);
-        for p in self.seam_points(samples) {
-            sum += difference(p.left, p.right) as f64 * p.weight as f64;
-            total += p.weight as f64;
-        }
-        (total > 0.0).then(|| sum / total)
     }
 }

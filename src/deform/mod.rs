@@ -6,24 +6,23 @@
 pub mod analysis;
 mod cuts;
 mod distortion;
+mod field;
 mod geodesic;
 mod gradient;
-mod grid;
 mod nearest;
 mod overlap;
-mod seams;
 
 pub use analysis::{Analysis, AnalysisInput, analyze};
-pub use cuts::{BoundaryCell, CutEdge, Cuts, SeamPoint};
+pub use cuts::{CutEdge, Cuts, SeamPoint};
 pub use distortion::{Distortion, distortion};
+pub use field::{ChartField, FieldSample, TriangleRaster};
 pub use gradient::{TriangleDeformation, deformation_gradient};
-pub use grid::{FieldGrid, FieldSample};
 pub use overlap::{UvOverlap, uv_coverage, uv_overlap};
-pub use seams::{channel_std, seam_metric};
 
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
+use crate::texture::tiling_blending::CutBands;
 use glam::{Vec2, Vec3};
 
 /// The tangent field o that orients the texture (Sec. 4.3).
@@ -78,16 +77,19 @@ impl Orientation {
 /// What `tessera deform` computes from a mesh.
 #[derive(Clone, Debug)]
 pub struct DeformationMaps {
-    /// The smoothing grid (theta and S at its vertices).
-    pub grid: FieldGrid,
+    /// The field smoothed per chart (theta and S at the UV vertices).
+    pub field: ChartField,
+    /// The triangle each texel of the maps takes F from ([`TriangleRaster`]).
+    pub raster: TriangleRaster,
     /// The F map: `res` x `res`, 4 channels (F00, F01, F10, F11), row 0 at the top (v = 1), as
-    /// image textures are laid out, sampled at texel centres from the grid (Eq. 7).
+    /// image textures are laid out: the field at each texel centre, in the triangle covering
+    /// it or (outside every triangle) extrapolated from the nearest one, so that the map's
+    /// bilinear lookups near a chart's border read that chart's field.
     pub f_map: Bitmap,
-    /// The UV cuts and their boundary cells (Sec. 5).
+    /// The UV cuts, chained.
     pub cuts: Cuts,
-    /// The cut map: `res` x `res`, 4 channels (l + 1, b.x, b.y, sigma), row 0 at the top
-    /// ([`Cuts::cut_map`]).
-    pub cut_map: Bitmap,
+    /// The cut bands of the cuts' curves for the F map and the tile size ([`CutBands`]).
+    pub bands: CutBands,
     /// Triangles skipped because they are degenerate in 3D or in UV.
     pub degenerate: usize,
     /// Triangles whose UVs are mirrored (R is a reflection there).
@@ -98,6 +100,12 @@ pub struct DeformationMaps {
 }
 
 impl DeformationMaps {
+    /// The chart of the triangle each texel of the maps takes F from (row-major from the
+    /// bottom row).
+    pub fn chart_of_texels(&self) -> Vec<u32> {
+        self.raster.owner.iter().map(|&t| self.field.chart_of_triangle[t as usize]).collect()
+    }
+
     /// How much of the UV square more than one triangle covers, at the maps' resolution.
     pub fn overlap(&self) -> UvOverlap {
         UvOverlap::of_coverage(&self.coverage)
@@ -105,25 +113,26 @@ impl DeformationMaps {
 }
 
 /// Derive the deformation field of `mesh` (which must have UVs): F = R(theta) S per triangle,
-/// smoothed on a `grid` x `grid` grid, written as a `res` x `res` F map; and the cut map for
-/// tiles of lattice spacing `tile_size` (cells longer than a tile's diameter, 2 `tile_size`,
-/// on both sides; bands as wide as the square tiling's support radius, sqrt 2 `tile_size`, so
-/// that every tile reaching a cut is centred in its band for either tiling).
+/// smoothed per chart with `smoothing` rounds of vertex averaging ([`ChartField`]), written as
+/// a `res` x `res` F map; and the cut bands of its cuts for tiles of lattice spacing
+/// `tile_size`.
 pub fn deformation_maps(
     mesh: &TriangleMesh,
     orientation: &Orientation,
-    grid: usize,
+    smoothing: usize,
     res: usize,
     tile_size: f32,
 ) -> Result<DeformationMaps, String> {
     mesh.check()?;
     let uvs = mesh.uvs.as_ref().ok_or("the mesh has no texture coordinates")?;
-    if grid == 0 || res == 0 {
-        return Err("the grid and the map need at least one sample per side".into());
+    if res == 0 {
+        return Err("the maps need at least one texel per side".into());
     }
-    if grid > limits::MAX_DEFORM_GRID as usize || res > limits::MAX_DEFORM_RES as usize {
-        let (max_grid, max_res) = (limits::MAX_DEFORM_GRID, limits::MAX_DEFORM_RES);
-        return Err(format!("grid {grid} or maps {res} over tessera's limits of {max_grid} and {max_res} per side"));
+    if smoothing > limits::MAX_DEFORM_SMOOTHING as usize || res > limits::MAX_DEFORM_RES as usize {
+        let (max_smoothing, max_res) = (limits::MAX_DEFORM_SMOOTHING, limits::MAX_DEFORM_RES);
+        return Err(format!(
+            "{smoothing} smoothing rounds or maps {res} over tessera's limits of {max_smoothing} rounds and {max_res} per side"
+        ));
     }
     if let Orientation::PerVertex(tangents) = orientation {
         if tangents.len() != mesh.positions.len() || !tangents.iter().all(|t| t.is_finite()) {
@@ -141,7 +150,7 @@ pub fn deformation_maps(
     let mut mirrored = 0;
     let mut uv_triangles = Vec::with_capacity(mesh.indices.len());
     let directions = orientation.per_triangle(mesh);
-    let values: Vec<Option<FieldSample>> = mesh
+    let samples: Vec<field::TriangleSample> = mesh
         .indices
         .iter()
         .zip(&directions)
@@ -157,22 +166,22 @@ pub fn deformation_maps(
                 mirrored += 1;
             }
             let theta = direction.map_or(0.0, |o| d.orientation_angle(o));
-            Some(FieldSample { direction: Vec2::from_angle(theta), stretch: d.signed_stretch() })
+            Some((FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch }, d.mirrored()))
         })
         .collect();
-    let grid = FieldGrid::new(grid, &uv_triangles, &values).ok_or("every triangle is degenerate")?;
+    let field = ChartField::new(mesh, &samples, smoothing).ok_or("every triangle is degenerate")?;
+    let raster =
+        TriangleRaster::new(res, &uv_triangles, |t| samples[t].is_none()).ok_or("every triangle is degenerate")?;
     let mut f_map = Bitmap::new(res, res, 4);
-    for (row, line) in f_map.data.chunks_exact_mut(res * 4).enumerate() {
-        let v = ((res - 1 - row) as f32 + 0.5) / res as f32;
-        for (col, px) in line.chunks_exact_mut(4).enumerate() {
-            let f = grid.at(Vec2::new((col as f32 + 0.5) / res as f32, v));
-            px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
-        }
+    for (k, &t) in raster.owner.iter().enumerate() {
+        let b = field::barycentric(raster.point(k), uv_triangles[t as usize]).unwrap_or(Vec3::ONE);
+        let f = field.at(t as usize, b);
+        f_map.values_mut(k % res, res - 1 - k / res).copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
     }
     let coverage = uv_coverage(&uv_triangles, res);
-    let cuts = Cuts::new(mesh, 2.0 * tile_size);
-    let cut_map = cuts.cut_map(&f_map, std::f32::consts::SQRT_2 * tile_size);
-    Ok(DeformationMaps { grid, f_map, cuts, cut_map, degenerate, mirrored, coverage })
+    let cuts = Cuts::new(mesh);
+    let bands = CutBands::new(cuts.curves(&field, &uv_triangles), &f_map, tile_size)?;
+    Ok(DeformationMaps { field, raster, f_map, cuts, bands, degenerate, mirrored, coverage })
 }
 
 /// Pictures of an F map for people to look at: log2 |det F| as grey (0.5 at 1, black at 1/16,
@@ -193,15 +202,21 @@ pub fn f_map_pictures(f_map: &Bitmap) -> (Bitmap, Bitmap) {
     (det, orientation)
 }
 
-/// A picture of a cut map: each boundary cell in its own colour (the same on both sides of the
-/// cut), black outside the bands.
-pub fn cut_map_picture(cut_map: &Bitmap) -> Bitmap {
-    let mut picture = Bitmap::new(cut_map.width, cut_map.height, 3);
-    for (k, texel) in cut_map.data.chunks_exact(4).enumerate() {
-        if texel[0] > 0.0 {
-            let bits = crate::sampling::mix64(texel[0] as u64);
-            let colour = [0, 16, 32].map(|s| 0.15 + 0.85 * ((bits >> s) & 0xffff) as f32 / 65535.0);
-            picture.data[k * 3..k * 3 + 3].copy_from_slice(&colour);
+/// A picture of cut bands at `res` x `res`: each cut's band in its own colour, the same on both
+/// sides, darker away from the cut (its weight psi); black outside the bands.
+pub fn bands_picture(bands: &CutBands, f_map: &Bitmap) -> Bitmap {
+    let res = f_map.width;
+    let mut picture = Bitmap::new(res, res, 3);
+    for row in 0..res {
+        for col in 0..res {
+            let uv = Vec2::new(col as f32 + 0.5, (res - 1 - row) as f32 + 0.5) / res as f32;
+            let f = f_map.values(col, row);
+            let f = glam::Mat2::from_cols(Vec2::new(f[0], f[2]), Vec2::new(f[1], f[3]));
+            if let Some(band) = bands.at(uv, f)[0] {
+                let bits = crate::sampling::mix64(band.curve as u64 + 1);
+                let colour = [0, 16, 32].map(|s| band.weight * (0.15 + 0.85 * ((bits >> s) & 0xffff) as f32 / 65535.0));
+                picture.values_mut(col, row).copy_from_slice(&colour);
+            }
         }
     }
     picture

@@ -19,7 +19,9 @@ use crate::limits;
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
 };
-use crate::texture::tiling_blending::{Blend, CutMap, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
+use crate::texture::tiling_blending::{
+    Blend, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
+};
 use crate::texture::{ImageTexture, MipMap, Texture, TilingBlending};
 use glam::{Mat2, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
@@ -468,8 +470,15 @@ impl<'a> Loader<'a> {
             Some(filename) => {
                 let file = self.resolve_path(filename);
                 let item = format!("{item}.cuts");
-                let bitmap = read_bitmap_raw(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, &item))?;
-                Some(CutMap::new(&bitmap).map_err(|msg| Error::image(&file, msg).in_scene(self.path, &item))?)
+                let f_map = deformation.as_ref().and_then(|d| d.map_texels()).ok_or_else(|| {
+                    self.error(format!(
+                        "{item}: cut bands need a deformation with a map factor (their lengths are in its units)"
+                    ))
+                })?;
+                let text = crate::files::read_text_bounded(&file, limits::MAX_CUTS_FILE_BYTES, "a cuts file")
+                    .map_err(|e| e.in_scene(self.path, &item))?;
+                let bands = cuts_from_json(&text).and_then(|curves| CutBands::new(curves, f_map, tile_size));
+                Some(bands.map_err(|msg| Error::mesh(&file, msg).in_scene(self.path, &item))?)
             }
         };
         let synthesis = Arc::new(Synthesis {

@@ -100,14 +100,15 @@ impl DeformationField {
         }
     }
 
-    /// The product of the largest singular values of the factors other than F maps at `uv`: how
-    /// much they can stretch what a map gives (1 without such factors).
-    pub fn stretch_besides_maps(&self, uv: Vec2) -> f32 {
-        self.factors
-            .iter()
-            .filter(|f| !matches!(f, Deformation::Map(_)))
-            .map(|f| crate::math::largest_singular_value(f.at(uv)))
-            .product()
+    /// The first F map factor at `uv` (None without one): the field whose units cut bands
+    /// measure in.
+    pub fn map_at(&self, uv: Vec2) -> Option<Mat2> {
+        self.factors.iter().find(|f| matches!(f, Deformation::Map(_))).map(|f| bounded(f.at(uv)))
+    }
+
+    /// The first F map factor's texels (None without one).
+    pub fn map_texels(&self) -> Option<&crate::image::Bitmap> {
+        self.factors.iter().find_map(|f| if let Deformation::Map(m) = f { Some(m.level(0)) } else { None })
     }
 
     /// Bytes held by F maps.

@@ -12,13 +12,14 @@ mod deformation;
 mod histogram;
 mod tiling;
 
-pub use cuts::{CellTexel, CutMap};
+pub use cuts::{BANDS_PER_POINT, BandLookup, CutBands, CutCurve, CutPoint, cuts_from_json, cuts_to_json};
 pub use deformation::{Deformation, DeformationField};
 pub use histogram::GaussianizedExemplar;
-pub use tiling::{MAX_TILES, Tile, Tiling, cell_shift, shift};
+pub use tiling::{MAX_TILES, Tile, Tiling, cut_shift, shift};
 
 use super::{ImageTexture, TexCtx, Texture};
 use crate::color::{Rgb, luminance};
+use crate::math::largest_singular_value;
 use glam::{Mat2, Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -115,9 +116,10 @@ pub struct Synthesis {
     pub seed: u64,
     /// The deformation field F; None is classical tiling and blending (Eq. 2).
     pub deformation: Option<DeformationField>,
-    /// The cut map: tiles centred in a boundary cell take its centre and shift (Eq. 8), so that
-    /// both sides of a UV cut blend the same tiles. None leaves cuts alone.
-    pub cuts: Option<CutMap>,
+    /// The cut bands: near a UV cut, rows of tiles along the cut that both of its sides read
+    /// alike ([`CutBands`]). None leaves cuts alone. They need an F map among the deformation's
+    /// factors (their lengths are in its units).
+    pub cuts: Option<CutBands>,
     /// The blending operator.
     pub blend: Blend,
     /// Keep each tile inside the exemplar's unit square where it fits (for exemplars that do
@@ -126,6 +128,9 @@ pub struct Synthesis {
     /// are uniform over the square and lookups wrap around it.
     pub inset: bool,
 }
+
+/// Most lookups at a point: the paving's tiles and two tiles per cut band.
+pub const MAX_LOOKUPS: usize = MAX_TILES + 2 * BANDS_PER_POINT;
 
 /// One tile's lookup into the exemplar and its paving weight.
 #[derive(Clone, Copy, Debug, Default)]
@@ -148,45 +153,78 @@ impl Synthesis {
         self.deformation.as_ref().map_or(Mat2::IDENTITY, |d| d.at(uv))
     }
 
-    /// The tiles' exemplar lookups at `ctx` (Eq. 3; Sec. 6.1 for the footprint). Without a
-    /// deformation field the lookup is u - c_i + h_i: Eq. 2 with the shift h_i - c_i, so that
-    /// F = identity reproduces it exactly. With a cut map, a tile centred in boundary cell l
-    /// reads E(F(u) (u - b_l) + h_l) (Eq. 8); tiles of the same cell and side are then the same
-    /// tile, and their weights are summed into the first (the others get weight 0), so that a
-    /// point covered by one cell only reads exactly that cell's tile whatever the operator.
+    /// The tiles' exemplar lookups at `ctx` (Eq. 3; Sec. 6.1 for the footprint) and how many
+    /// there are. Without a deformation field the lookup is u - c_i + h_i: Eq. 2 with the shift
+    /// h_i - c_i, so that F = identity reproduces it exactly. Within a cut band of weight psi
+    /// the paving's weights are scaled by 1 - psi and the band's row of tiles along the cut
+    /// takes the rest ([`CutBands`]); where two bands overlap, band b weighs
+    /// psi_b (1 - psi_other), normalised, so that on a cut only its own row is read.
     #[inline]
-    pub fn lookups(&self, ctx: &TexCtx) -> [TileLookup; MAX_TILES] {
+    pub fn lookups(&self, ctx: &TexCtx) -> ([TileLookup; MAX_LOOKUPS], usize) {
         let k = self.tiles_per_point();
         let tiles = self.tiling.tiles(ctx.uv, self.tile_size);
         let f = self.deformation.as_ref().map(|d| d.at(ctx.uv));
-        let mut out = [TileLookup::default(); MAX_TILES];
-        let mut cells: [Option<CellTexel>; MAX_TILES] = [None; MAX_TILES];
+        let mut out = [TileLookup::default(); MAX_LOOKUPS];
         for i in 0..k {
             let tile = &tiles[i];
-            cells[i] = self.cuts.as_ref().and_then(|c| c.at(tile.centre));
-            let (centre, h) = match cells[i] {
-                Some(cell) => {
-                    if let Some(first) = (0..i).find(|&j| cells[j] == Some(cell)) {
-                        out[first].weight += tile.weight;
-                        out[i] = TileLookup { weight: 0.0, ..out[first] };
-                        continue;
-                    }
-                    let h = cell_shift(cell.cell, self.seed);
-                    (cell.centre, if self.inset { inset_shift(h, Vec2::splat(self.cell_reach(&cell))) } else { h })
-                }
-                None => {
-                    let h = shift(tile.vertex, self.seed);
-                    (tile.centre, if self.inset { inset_shift(h, self.tile_reach(tile.centre)) } else { h })
-                }
-            };
-            let offset = ctx.uv - centre;
+            let h = shift(tile.vertex, self.seed);
+            let h = if self.inset { inset_shift(h, self.tile_reach(tile.centre)) } else { h };
+            let offset = ctx.uv - tile.centre;
             out[i].weight = tile.weight;
             out[i].ctx = match f {
                 None => TexCtx { uv: offset + h, ..*ctx },
                 Some(f) => TexCtx { uv: f * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy },
             };
         }
-        out
+        let count = k + self.band_lookups(ctx, f.unwrap_or(Mat2::IDENTITY), &mut out);
+        (out, count)
+    }
+
+    /// Append the cut bands' lookups at `ctx` after the paving's (`f` is F there), reweighting
+    /// both; returns how many were appended.
+    #[inline]
+    fn band_lookups(&self, ctx: &TexCtx, f: Mat2, out: &mut [TileLookup; MAX_LOOKUPS]) -> usize {
+        let (Some(cuts), Some(field)) = (&self.cuts, &self.deformation) else { return 0 };
+        let Some(f_map) = field.map_at(ctx.uv) else { return 0 };
+        let bands = cuts.at(ctx.uv, f_map);
+        if bands.iter().all(Option::is_none) || !(f_map.determinant().abs() > 1e-20) {
+            return 0;
+        }
+        // The factors other than the map, which carry map units to the exemplar's.
+        let other = f * f_map.inverse();
+        let psi = bands.map(|b| b.map_or(0.0, |b| b.weight));
+        let mut band_weight = [0.0f32; BANDS_PER_POINT];
+        for b in 0..BANDS_PER_POINT {
+            band_weight[b] = psi[b] * (0..BANDS_PER_POINT).filter(|&o| o != b).map(|o| 1.0 - psi[o]).product::<f32>();
+        }
+        let mut paving: f32 = psi.iter().map(|p| 1.0 - p).product();
+        let mut total = paving + band_weight.iter().sum::<f32>();
+        if !(total > 1e-6) {
+            // On two cuts at once (where they meet): the nearest alone.
+            (band_weight, paving, total) = ([1.0, 0.0], 0.0, 1.0);
+        }
+        let k = self.tiles_per_point();
+        for lookup in &mut out[..k] {
+            lookup.weight *= paving / total;
+        }
+        let stretch = largest_singular_value(other);
+        let mut n = 0;
+        for (band, w) in bands.iter().zip(band_weight) {
+            let Some(band) = band else { continue };
+            if w <= 0.0 {
+                continue;
+            }
+            for (m, tile_weight, offset) in band.tiles {
+                let h = cut_shift(band.curve, m, self.seed);
+                let h = if self.inset { inset_shift(h, Vec2::splat(band.reach * stretch)) } else { h };
+                out[k + n] = TileLookup {
+                    ctx: TexCtx { uv: other * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy },
+                    weight: tile_weight * w / total,
+                };
+                n += 1;
+            }
+        }
+        n
     }
 
     /// How far, per axis, a tile centred at `centre` reaches into the exemplar: its support's
@@ -196,20 +234,12 @@ impl Synthesis {
         self.tiling.support_corners().iter().fold(Vec2::ZERO, |r, corner| r.max((f * (*corner * self.tile_size)).abs()))
     }
 
-    /// How far a tile of a boundary cell reaches into the exemplar along any axis, the same on
-    /// both sides of the cut (whose UV axes differ): the cut map's reach through the F map,
-    /// times the largest singular values of the field's other factors at this side's centre
-    /// (exactly the same on both sides for constant factors).
-    fn cell_reach(&self, cell: &CellTexel) -> f32 {
-        cell.reach * self.deformation.as_ref().map_or(1.0, |d| d.stretch_besides_maps(cell.centre))
-    }
-
     /// The blending weights of the tiles: the paving's for the linear and variance-preserving
     /// operators, reweighted and normalised for the others. `values` are the tiles' exemplar
     /// values and `exemplar` their texture (reused when it is the weights' source).
-    fn weights(&self, lookups: &[TileLookup], values: &[Vec4], exemplar: Option<&Arc<Texture>>) -> [f32; MAX_TILES] {
-        let k = self.tiles_per_point();
-        let mut w = [0.0; MAX_TILES];
+    fn weights(&self, lookups: &[TileLookup], values: &[Vec4], exemplar: Option<&Arc<Texture>>) -> [f32; MAX_LOOKUPS] {
+        let k = lookups.len();
+        let mut w = [0.0; MAX_LOOKUPS];
         match &self.blend {
             Blend::Linear | Blend::VariancePreserving | Blend::HistogramPreserving => {
                 for i in 0..k {
@@ -227,9 +257,9 @@ impl Synthesis {
                 }
             }
             Blend::MixMax { priority, contrast, lambda } => {
-                let mut score = [f32::NEG_INFINITY; MAX_TILES];
-                let mut variance = [0.0; MAX_TILES];
-                // Tiles of weight 0 (merged into another by Eq. 8) take no part.
+                let mut score = [f32::NEG_INFINITY; MAX_LOOKUPS];
+                let mut variance = [0.0; MAX_LOOKUPS];
+                // Tiles of weight 0 (outside a cut band's reach) take no part.
                 let live = |i: usize| lookups[i].weight > 0.0;
                 for i in (0..k).filter(|&i| live(i)) {
                     let (s, var) = priority.mean_and_variance(&lookups[i].ctx);
@@ -337,15 +367,15 @@ impl TilingBlending {
     /// The synthesised value at the lookup (Eq. 1 with the blending operator).
     pub fn eval(&self, ctx: &TexCtx) -> Vec4 {
         let s = &*self.synthesis;
-        let k = s.tiles_per_point();
-        let lookups = s.lookups(ctx);
-        let mut values = [Vec4::ZERO; MAX_TILES];
+        let (lookups, k) = s.lookups(ctx);
+        let lookups = &lookups[..k];
+        let mut values = [Vec4::ZERO; MAX_LOOKUPS];
         match &self.exemplar {
             Exemplar::Plain { texture, mean } => {
                 for i in 0..k {
                     values[i] = texture.eval(&lookups[i].ctx);
                 }
-                let w = s.weights(&lookups, &values, Some(texture));
+                let w = s.weights(lookups, &values, Some(texture));
                 match s.blend {
                     Blend::VariancePreserving => variance_preserving(&w[..k], &values[..k], *mean),
                     _ => (0..k).map(|i| values[i] * w[i]).sum(),
@@ -355,7 +385,7 @@ impl TilingBlending {
                 for i in 0..k {
                     values[i] = g.eval(&lookups[i].ctx);
                 }
-                let w = s.weights(&lookups, &values, None);
+                let w = s.weights(lookups, &values, None);
                 let blended = variance_preserving(&w[..k], &values[..k], Vec4::splat(histogram::GAUSSIAN_MEAN));
                 // All tiles' footprints are F times the same one: they read the same level.
                 g.invert(blended, &lookups[0].ctx)
@@ -370,13 +400,13 @@ impl TilingBlending {
     pub fn eval_normal(&self, ctx: &TexCtx) -> Option<Vec3> {
         let Exemplar::Plain { texture, .. } = &self.exemplar else { return None };
         let s = &*self.synthesis;
-        let k = s.tiles_per_point();
-        let lookups = s.lookups(ctx);
-        let mut values = [Vec4::ZERO; MAX_TILES];
+        let (lookups, k) = s.lookups(ctx);
+        let lookups = &lookups[..k];
+        let mut values = [Vec4::ZERO; MAX_LOOKUPS];
         for i in 0..k {
             values[i] = texture.eval(&lookups[i].ctx);
         }
-        let w = s.weights(&lookups, &values, Some(texture));
+        let w = s.weights(lookups, &values, Some(texture));
         let total: f32 = w[..k].iter().sum();
         let mut slope = Vec2::ZERO;
         for i in 0..k {

@@ -131,11 +131,12 @@ pub fn shift(vertex: IVec2, seed: u64) -> Vec2 {
     shift_of_key(seed ^ ((vertex.x as u32 as u64) << 32 | vertex.y as u32 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
 }
 
-/// The shared shift h_l of the tiles of boundary cell `cell` under `seed` (paper 000 Eq. 8),
+/// The shift of tile `m` of the row along cut `curve` under `seed` ([`super::CutBands`]),
 /// drawn like a lattice vertex's from a separate key space.
 #[inline]
-pub fn cell_shift(cell: u32, seed: u64) -> Vec2 {
-    shift_of_key(seed.rotate_left(29) ^ (cell as u64 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93))
+pub fn cut_shift(curve: u32, m: i64, seed: u64) -> Vec2 {
+    let key = (curve as u64 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93) ^ (m as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    shift_of_key(seed.rotate_left(29) ^ key)
 }
 
 #[inline]
