@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 use tessera::error::{Error, Result};
-use tessera::image::{Aov, Bitmap, write_image};
+use tessera::image::{Aov, Bitmap, ColorSpace, OutputFormat, read_bitmap, write_image};
 use tessera::integrator::{Crop, render};
 use tessera::limits;
 use tessera::scene::{Scene, SceneOverrides, load_scene};
@@ -84,6 +84,21 @@ enum Command {
         /// the smallest p-value of each pixel.
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Lay images out on a labelled grid (PNG or EXR), e.g. classical against deformed renders.
+    Montage {
+        /// The images, in reading order (EXR, PNG, JPEG, HDR).
+        #[arg(required = true)]
+        images: Vec<PathBuf>,
+        /// Images per row.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=1024))]
+        columns: u32,
+        /// A caption per image, in order (default: the files' names without extension).
+        #[arg(long = "label")]
+        labels: Vec<String>,
+        /// Output image (.png or .exr).
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Write a scene as Mitsuba 3 XML (meshes as OBJ, textures baked to EXR) to render it there.
     ExportMitsuba {
@@ -193,6 +208,10 @@ pub fn run() -> Result<ExitCode> {
         }
         Command::Diff { test, reference, variance, spp, max_relmse, max_flip, output } => {
             diff(&test, &reference, variance.as_deref().zip(spp), max_relmse, max_flip, output.as_deref())
+        }
+        Command::Montage { images, columns, labels, output } => {
+            montage(&images, columns as usize, &labels, &output)?;
+            Ok(ExitCode::SUCCESS)
         }
         Command::ExportMitsuba { scene, output, spp, bake_res } => {
             let scene = load(&scene, &SceneOverrides { spp, ..Default::default() }, false)?;
@@ -476,4 +495,36 @@ fn print_info(scene: &Scene) {
     let emissive = g.triangle_shape.iter().filter(|&&s| g.shapes[s as usize].light.is_some()).count();
     println!("lights     {} area ({emissive} triangles), environment: {env}", scene.lights.area.len());
     println!("memory     {:.1} MiB (geometry, BVH, textures)", scene.memory_bytes() as f64 / (1 << 20) as f64);
+}
+
+/// `tessera montage`: read the images, caption them, grid them, write the result.
+fn montage(images: &[PathBuf], columns: usize, labels: &[String], output: &Path) -> Result<()> {
+    if !labels.is_empty() && labels.len() != images.len() {
+        return Err(Error::param(
+            "--label",
+            format!("{} labels for {} images: give one per image, or none", labels.len(), images.len()),
+        ));
+    }
+    OutputFormat::from_path(output)?;
+    let mut cells = Vec::with_capacity(images.len());
+    for (k, path) in images.iter().enumerate() {
+        let bitmap = read_bitmap(path, ColorSpace::Srgb)?;
+        let label = match labels.get(k) {
+            Some(label) => label.clone(),
+            None => path.file_stem().map_or(String::new(), |s| s.to_string_lossy().into_owned()),
+        };
+        cells.push((bitmap, label));
+    }
+    let grid = tessera::image::montage(&cells, columns, limits::MAX_RENDER_PIXELS)
+        .map_err(|msg| Error::param("montage", msg))?;
+    write_image(output, &grid, &[])?;
+    eprintln!(
+        "{} images on {} columns -> {} ({} x {})",
+        images.len(),
+        columns.min(images.len()),
+        output.display(),
+        grid.width,
+        grid.height
+    );
+    Ok(())
 }

@@ -6,7 +6,9 @@ mod bitmap;
 pub mod compare;
 mod film;
 mod io;
+mod montage;
 
 pub use bitmap::{Bitmap, ColorSpace};
 pub use film::{Aov, Film, PixelSum};
 pub use io::{OutputFormat, decode_image, read_bitmap, read_bitmap_raw, write_exr, write_image, write_png};
+pub use montage::montage;

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Regenerate the deformation maps of the Fig. 8 scenes in this folder: the F map and cuts of the
+# lat-long icosphere (texture along the parallels around its z axis, which the scenes turn
+# upright) and of the cube-map sphere (parallels around y). Run from anywhere.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+cargo build --release --locked
+for spec in "latlong scenes/meshes/smiley.obj parallels:0,0,1" "cube scenes/meshes/cube_sphere.obj parallels:0,1,0"; do
+  set -- $spec
+  out=$(mktemp -d)
+  ./target/release/tessera deform "$2" --orientation "$3" --tile-size 0.04 --res 512 -o "$out"
+  mkdir -p "scenes/brushed/maps/$1"
+  cp "$out/f_map.exr" "$out/cuts.json" "scenes/brushed/maps/$1/"
+  rm -r "$out"
+done
