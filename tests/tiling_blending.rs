@@ -527,3 +527,43 @@ fn inset_shifts_keep_tiles_inside_a_non_tileable_exemplar() {
         assert!(lo.max_element() < 0.05 && hi.min_element() > 0.95, "{tiling:?}: {lo} .. {hi}");
     }
 }
+
+#[test]
+fn the_lattice_shows_where_mix_max_lets_the_tiles_centres_win_and_nowhere_else() {
+    // The rock exemplar is stationary: blended with its histogram preserved, the synthesis has
+    // the exemplar's power at the paving's lattice frequencies. Mix-Max with its default
+    // contrast (4) lets each tile's centre win whatever its priority while bright rocks win the
+    // transitions: a grid of dark centres that the lattice visibility catches; a contrast of 32
+    // lets the rocks decide and the grid goes.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textures/rocks_basecolor.jpg");
+    let bitmap = tessera::image::read_bitmap(&path, tessera::image::ColorSpace::Srgb).unwrap();
+    let image = ImageTexture {
+        mipmap: Arc::new(MipMap::new(bitmap)),
+        filter: Filter::None,
+        scale: Vec2::ONE,
+        offset: Vec2::ZERO,
+    };
+    let exemplar = Arc::new(Texture::Image(image.clone()));
+    let visibility = |blend: Blend| {
+        let synthesis = Synthesis {
+            tiling: Tiling::Hexagonal,
+            tile_size: 0.1,
+            seed: 3,
+            deformation: Some(DeformationField::new(vec![Deformation::Constant(Mat2::from_diagonal(Vec2::splat(
+                3.0,
+            )))])),
+            cuts: None,
+            blend,
+            inset: false,
+        };
+        let texture = TilingBlending::new(Arc::new(synthesis), exemplar.clone()).unwrap();
+        tessera::texture::tiling_blending::synthesis_lattice_visibility(&texture, 256, &[3, 4, 5, 6]).unwrap()
+    };
+    let histogram = visibility(Blend::HistogramPreserving);
+    let mix_max =
+        |contrast: f32| visibility(Blend::MixMax { priority: PriorityMap::new(&image), contrast, lambda: 0.05 });
+    let (low, high) = (mix_max(4.0), mix_max(32.0));
+    eprintln!("lattice visibility: histogram-preserving {histogram:.2}, Mix-Max contrast 4 {low:.2}, 32 {high:.2}");
+    assert!(histogram < 1.5 && high < 1.5, "{histogram} {high}");
+    assert!(low > 5.0, "{low}");
+}

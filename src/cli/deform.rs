@@ -248,6 +248,12 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
             e.mean, e.p95
         );
     }
+    if let Some(v) = a.lattice_visibility {
+        println!(
+            "lattice visibility (power at the paving's lattice frequencies over the exemplar's there, classical \
+             synthesis, four seeds; about 1 for a stationary exemplar): {v:.2}"
+        );
+    }
     println!(
         "fold-over of the tiles' lookups F(u)(u - c), tile centres {} away: {:.3}% of {} texels fold, {:.3}% stretch \
          beyond 2:1; UV area covered more than once: {:.3}%",

@@ -246,6 +246,22 @@ pub fn run() -> Result<ExitCode> {
                 start.elapsed().as_secs_f64(),
                 output.display()
             );
+            if let tessera::texture::Texture::TilingBlending(t) = &tex {
+                let seed = t.synthesis.seed;
+                let seeds: Vec<u64> = (0..4).map(|k| seed.wrapping_add(k)).collect();
+                let figure = tessera::texture::tiling_blending::synthesis_lattice_visibility(
+                    t,
+                    tessera::deform::analysis::LATTICE_BAKE_RES,
+                    &seeds,
+                );
+                if let Some(v) = figure {
+                    eprintln!(
+                        "lattice visibility {v:.2} (power at the paving's lattice frequencies over the exemplar's there, \
+                         seeds {seed} to {}; about 1 for a stationary exemplar)",
+                        seed.wrapping_add(3)
+                    );
+                }
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::Deform { mesh, output } => deform::deform(&mesh, &output),

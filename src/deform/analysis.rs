@@ -20,7 +20,9 @@ use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
 use crate::math::largest_singular_value;
-use crate::texture::tiling_blending::{Blend, CutBands, Deformation, DeformationField, Synthesis, Tiling};
+use crate::texture::tiling_blending::{
+    Blend, CutBands, Deformation, DeformationField, Synthesis, Tiling, synthesis_lattice_visibility,
+};
 use crate::texture::{MipMap, TexCtx, Texture, TilingBlending};
 use glam::{Mat2, Vec2, Vec3};
 use std::sync::Arc;
@@ -239,6 +241,9 @@ pub struct Analysis {
     pub fold_over: FoldOver,
     /// Fraction of the UV area covered more than once.
     pub uv_overlap: f64,
+    /// How visible the paving's lattice is in the classical synthesis of the exemplar (F = I;
+    /// [`synthesis_lattice_visibility`], four seeds): about 1 where the exemplar is stationary.
+    pub lattice_visibility: Option<f64>,
 }
 
 /// What [`analyze`] measures: a mesh with UVs, the maps `deform` derived from it with its
@@ -262,6 +267,9 @@ pub struct AnalysisInput<'a> {
     pub samples: usize,
 }
 
+/// Side of the bakes the lattice visibility is measured on.
+pub const LATTICE_BAKE_RES: usize = 512;
+
 /// Measure everything [`Analysis`] holds.
 pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
     let (mesh, maps) = (input.mesh, input.maps);
@@ -269,6 +277,18 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
     let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
     let edges = maps.cuts.edges.len();
     let samples = input.samples.min((limits::MAX_SEAM_SAMPLES / edges.max(1)).max(1));
+    let classical = Synthesis {
+        tiling: Tiling::Hexagonal,
+        tile_size: input.tile_size,
+        seed: input.seed,
+        deformation: None,
+        cuts: None,
+        blend: Blend::Linear,
+        inset: false,
+    };
+    let classical = TilingBlending::new(Arc::new(classical), input.exemplar.clone())?;
+    let seeds: Vec<u64> = (0..4).map(|k| input.seed.wrapping_add(k)).collect();
+    let lattice_visibility = synthesis_lattice_visibility(&classical, LATTICE_BAKE_RES, &seeds);
     let seams = (edges > 0)
         .then(|| -> Result<SeamReport, String> {
             let measure = |deformation: Option<DeformationField>, cuts: Option<CutBands>| {
@@ -306,6 +326,7 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
         // A hexagonal tile reaches one lattice spacing from its centre.
         fold_over: fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), input.tile_size),
         uv_overlap: maps.overlap().fraction(),
+        lattice_visibility,
     })
 }
 

@@ -10,11 +10,13 @@
 mod cuts;
 mod deformation;
 mod histogram;
+mod lattice;
 mod tiling;
 
 pub use cuts::{BANDS_PER_POINT, BandLookup, CutBands, CutCurve, CutPoint, cuts_from_json, cuts_to_json};
 pub use deformation::{Deformation, DeformationField};
 pub use histogram::GaussianizedExemplar;
+pub use lattice::{lattice_frequencies, lattice_visibility, synthesis_lattice_visibility};
 pub use tiling::{MAX_TILES, Tile, Tiling, cut_shift, shift};
 
 use super::{ImageTexture, TexCtx, Texture};
@@ -362,6 +364,24 @@ impl TilingBlending {
             _ => Exemplar::Plain { mean: texture_mean(&exemplar), texture: exemplar },
         };
         Ok(TilingBlending { synthesis, exemplar })
+    }
+
+    /// The same exemplar read through another synthesis (which must use the same blending
+    /// operator).
+    pub fn with_synthesis(&self, synthesis: Arc<Synthesis>) -> Self {
+        TilingBlending { synthesis, exemplar: self.exemplar.clone() }
+    }
+
+    /// The exemplar's image (its Gaussianized image for the histogram-preserving operator);
+    /// None for a procedural exemplar.
+    pub fn exemplar_image(&self) -> Option<&crate::image::Bitmap> {
+        match &self.exemplar {
+            Exemplar::Plain { texture, .. } => match texture.as_ref() {
+                Texture::Image(image) => Some(image.mipmap.level(0)),
+                _ => None,
+            },
+            Exemplar::Gaussianized(g) => Some(g.gaussian.mipmap.level(0)),
+        }
     }
 
     /// The synthesised value at the lookup (Eq. 1 with the blending operator).
