@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 use tessera::deform::analysis::seams;
-use tessera::deform::{DeformationMaps, Orientation, deformation_maps};
+use tessera::deform::{DeformationMaps, Orientation, Smoothing, deformation_maps};
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap};
 use tessera::texture::tiling_blending::{Blend, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
@@ -94,7 +94,7 @@ fn two_chart_tube() -> TriangleMesh {
 }
 
 fn maps(mesh: &TriangleMesh, tile: f32) -> DeformationMaps {
-    deformation_maps(mesh, &Orientation::Parallels(Vec3::Y), 1, 512, tile).unwrap()
+    deformation_maps(mesh, &Orientation::Parallels(Vec3::Y), Smoothing::Vertices(1), 512, tile).unwrap()
 }
 
 /// The bark exemplar (point lookups), read once.

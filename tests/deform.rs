@@ -5,7 +5,7 @@
 mod common;
 
 use glam::{Mat2, Vec2, Vec3};
-use tessera::deform::{Orientation, deformation_maps};
+use tessera::deform::{Orientation, Smoothing, deformation_maps};
 use tessera::geometry::TriangleMesh;
 
 /// A strip of a cylinder of radius 0.5 about y (angles 0 to 1.6, height 0 to 0.8), unrolled
@@ -48,7 +48,8 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
         Orientation::Geodesic(vec![Vec3::ZERO]),
     ] {
         for scale in [1.0f32, 0.5] {
-            let maps = deformation_maps(&cylinder_strip(scale), &orientation, 1, 64, 0.25).unwrap();
+            let maps =
+                deformation_maps(&cylinder_strip(scale), &orientation, Smoothing::Vertices(1), 64, 0.25).unwrap();
             assert_eq!(maps.degenerate, 0);
             // F = R(theta) S with S = I / scale: F^T F = I / scale^2, det F = 1 / scale^2.
             for f in each_f(&maps.f_map) {
@@ -62,7 +63,7 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
         }
     }
     // With the UV orientation F is S alone: the identity here.
-    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Uv, 1, 64, 0.25).unwrap();
+    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Uv, Smoothing::Vertices(1), 64, 0.25).unwrap();
     assert!(each_f(&maps.f_map).all(|f| (f - Mat2::IDENTITY).to_cols_array().iter().all(|e| e.abs() < 2e-3)));
 }
 
@@ -70,7 +71,8 @@ fn an_isometrically_unrolled_developable_surface_gives_rotations() {
 fn fixed_orientation_lays_the_texture_along_the_direction() {
     // On the strip, the texture's x axis on the surface (J F^-1 e1, J = [dp/du dp/dv]) must run
     // along y, the cylinder's axis, which in this UV map is +v: so F^-1 e1 is along +v.
-    let maps = deformation_maps(&cylinder_strip(1.0), &Orientation::Fixed(Vec3::Y), 1, 64, 0.25).unwrap();
+    let maps =
+        deformation_maps(&cylinder_strip(1.0), &Orientation::Fixed(Vec3::Y), Smoothing::Vertices(1), 64, 0.25).unwrap();
     for f in each_f(&maps.f_map) {
         let along = (f.inverse() * Vec2::X).normalize();
         assert!(along.distance(Vec2::Y) < 1e-3, "{along}");
@@ -87,16 +89,16 @@ fn degenerate_triangles_are_counted_and_filled() {
     uvs[c as usize] = uvs[a as usize];
     let [d, e, _] = mesh.indices[100];
     mesh.positions[e as usize] = mesh.positions[d as usize];
-    let maps = deformation_maps(&mesh, &Orientation::Uv, 1, 64, 0.25).unwrap();
+    let maps = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 64, 0.25).unwrap();
     assert!(maps.degenerate >= 2, "{}", maps.degenerate);
     assert!(maps.f_map.data.iter().all(|v| v.is_finite()));
     // A mesh without UVs, or with every triangle degenerate, is an error, not a panic.
     let mut no_uv = cylinder_strip(1.0);
     no_uv.uvs = None;
-    assert!(deformation_maps(&no_uv, &Orientation::Uv, 1, 8, 0.25).is_err());
+    assert!(deformation_maps(&no_uv, &Orientation::Uv, Smoothing::Vertices(1), 8, 0.25).is_err());
     let mut flat = cylinder_strip(1.0);
     flat.uvs.as_mut().unwrap().iter_mut().for_each(|u| *u = Vec2::splat(0.5));
-    assert!(deformation_maps(&flat, &Orientation::Uv, 1, 8, 0.25).is_err());
+    assert!(deformation_maps(&flat, &Orientation::Uv, Smoothing::Vertices(1), 8, 0.25).is_err());
 }
 
 #[test]
@@ -138,7 +140,7 @@ fn the_field_compensates_a_lat_long_sphere_distortion() {
     // two triangles of each quad (their u edges lie on different parallels): a field matching
     // them would jump at every edge and fold the tiles' lookups, which it must not do here.
     let mesh = tessera::geometry::shapes::uv_sphere(64, 32);
-    let maps = deformation_maps(&mesh, &Orientation::Uv, 1, 256, 0.25).unwrap();
+    let maps = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 256, 0.25).unwrap();
     let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map.clone()));
     let classical = tessera::deform::distortion(&mesh, |_| Mat2::IDENTITY).unwrap();
     let deformed = tessera::deform::distortion(&mesh, |uv| f.at(uv)).unwrap();
@@ -156,7 +158,8 @@ fn geodesic_orientation_runs_away_from_the_source() {
     // along the arc, so the texture's x axis must point along +u where the strip is long.
     let strip = cylinder_strip(1.0);
     let source = Vec3::new(0.5, 0.4, 0.0);
-    let maps = deformation_maps(&strip, &Orientation::Geodesic(vec![source]), 1, 64, 0.25).unwrap();
+    let maps =
+        deformation_maps(&strip, &Orientation::Geodesic(vec![source]), Smoothing::Vertices(1), 64, 0.25).unwrap();
     let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map));
     // At the middle height, beyond the first third of the strip: away from the source is +u.
     for u in [0.5f32, 0.7, 0.85] {
@@ -171,7 +174,7 @@ fn a_scene_reads_the_written_f_map_as_deform_computed_it() {
     // Eq. 7 says at the map's texel centres (where the renderer's bilinear lookup is exact).
     // Its entries are signed (here F = -I where theta = pi): nothing may clamp them on load.
     let strip = cylinder_strip(1.0);
-    let maps = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), 1, 32, 0.25).unwrap();
+    let maps = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), Smoothing::Vertices(1), 32, 0.25).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let f = &maps.f_map;
     let plane = |c: usize| f.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
@@ -206,13 +209,16 @@ fn per_vertex_tangents_orient_like_the_field_they_sample() {
     // field around Y.
     let strip = cylinder_strip(1.0);
     let tangents: Vec<Vec3> = strip.positions.iter().map(|p| Vec3::Y.cross(*p)).collect();
-    let given = deformation_maps(&strip, &Orientation::PerVertex(tangents), 1, 32, 0.25).unwrap();
-    let parallels = deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), 1, 32, 0.25).unwrap();
+    let given = deformation_maps(&strip, &Orientation::PerVertex(tangents), Smoothing::Vertices(1), 32, 0.25).unwrap();
+    let parallels =
+        deformation_maps(&strip, &Orientation::Parallels(Vec3::Y), Smoothing::Vertices(1), 32, 0.25).unwrap();
     for (a, b) in given.f_map.data.iter().zip(&parallels.f_map.data) {
         assert!((a - b).abs() < 1e-4, "{a} vs {b}");
     }
     // One tangent per vertex, finite.
-    assert!(deformation_maps(&strip, &Orientation::PerVertex(vec![Vec3::X; 3]), 1, 8, 0.25).is_err());
+    assert!(
+        deformation_maps(&strip, &Orientation::PerVertex(vec![Vec3::X; 3]), Smoothing::Vertices(1), 8, 0.25).is_err()
+    );
 }
 
 #[test]
@@ -261,7 +267,7 @@ fn orientation_error_is_zero_where_the_field_is_followed_and_measures_a_turn() {
     use tessera::texture::tiling_blending::{Deformation, DeformationField};
     let mesh = cylinder_strip(1.0);
     for orientation in [Orientation::Fixed(Vec3::Y), Orientation::Parallels(Vec3::Y)] {
-        let maps = deformation_maps(&mesh, &orientation, 1, 64, 0.25).unwrap();
+        let maps = deformation_maps(&mesh, &orientation, Smoothing::Vertices(1), 64, 0.25).unwrap();
         let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
         let followed = orientation_error(&mesh, &orientation, |uv| field.at(uv)).unwrap();
         assert!(followed.mean < 0.1 && followed.p95 < 0.2, "{orientation:?}: {followed:?}");
@@ -272,4 +278,25 @@ fn orientation_error_is_zero_where_the_field_is_followed_and_measures_a_turn() {
         assert!((turned.mean - 30.0).abs() < 0.2 && (turned.p95 - 30.0).abs() < 0.3, "{orientation:?}: {turned:?}");
     }
     assert!(orientation_error(&mesh, &Orientation::Uv, |_| Mat2::IDENTITY).is_none());
+}
+
+#[test]
+fn triangles_own_fields_match_their_jacobians_but_tear_the_lookups() {
+    // Paper 000 Fig. 4 c against d: unsmoothed, each triangle's F makes the composite map a
+    // similarity on it (distortion 1 up to the map's texels), but F jumps at every edge, so the
+    // tiles' lookups F(u)(u - c) fold there; smoothed per chart, they do not.
+    let mesh = tessera::geometry::shapes::uv_sphere(64, 32);
+    let analyse = |smoothing: Smoothing| {
+        let maps = deformation_maps(&mesh, &Orientation::Uv, smoothing, 512, 0.05).unwrap();
+        let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map.clone()));
+        let distortion = tessera::deform::distortion(&mesh, |uv| f.at(uv)).unwrap();
+        let fold = tessera::deform::analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), 0.05);
+        (distortion, fold)
+    };
+    let (own, own_fold) = analyse(Smoothing::Triangles);
+    let (smoothed, smoothed_fold) = analyse(Smoothing::Vertices(1));
+    eprintln!("triangles: {own:?} {own_fold:?}; smoothed: {smoothed:?} {smoothed_fold:?}");
+    assert!(own.mean_anisotropy < 1.02 && own.std_log_area < 0.02, "{own:?}");
+    assert!(own_fold.folded + own_fold.stretched > 0.05, "{own_fold:?}");
+    assert_eq!(smoothed_fold.folded, 0.0, "{smoothed_fold:?}");
 }

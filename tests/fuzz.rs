@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, mpsc};
 use std::time::{Duration, Instant};
-use tessera::deform::{Orientation, deformation_maps};
+use tessera::deform::{Orientation, Smoothing, deformation_maps};
 use tessera::image::{Aov, Bitmap, ColorSpace};
 use tessera::integrator::{Crop, render};
 use tessera::scene::{SceneOverrides, load_scene_str, load_surface};
@@ -512,7 +512,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     if matches!(seed.kind, Kind::Obj | Kind::Gltf | Kind::Glb) {
         if let Ok((mesh, _)) = load_surface(&file) {
             if mesh.uvs.is_some() {
-                let _ = deformation_maps(&mesh, &Orientation::Uv, 1, 32, 0.25);
+                let _ = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 32, 0.25);
             }
         }
     } else {

@@ -298,8 +298,9 @@ fn deform(runs: usize) -> Result<()> {
     let mut times = Vec::new();
     for _ in 0..runs {
         let start = Instant::now();
-        let maps = tessera::deform::deformation_maps(&mesh, &orientation, 1, 1024, 0.25)
-            .map_err(|msg| Error::param("bench deform", msg))?;
+        let maps =
+            tessera::deform::deformation_maps(&mesh, &orientation, tessera::deform::Smoothing::Vertices(1), 1024, 0.25)
+                .map_err(|msg| Error::param("bench deform", msg))?;
         std::hint::black_box(maps.f_map.data.len());
         times.push(start.elapsed().as_secs_f64());
     }

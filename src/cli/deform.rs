@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 use tessera::deform::{
-    AnalysisInput, DeformationMaps, Distortion, Orientation, analysis, deformation_maps, distortion,
+    AnalysisInput, DeformationMaps, Distortion, Orientation, Smoothing, analysis, deformation_maps, distortion,
 };
 use tessera::error::{Error, Result};
 use tessera::files::StagedFolder;
@@ -25,9 +25,10 @@ pub struct MeshArgs {
     /// primitives in world space).
     mesh: PathBuf,
     /// Rounds of averaging of the field over each UV vertex's triangles, within its chart
-    /// (Sec. 4.4; 0 keeps each vertex the mean of its triangles; at most 256).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=limits::MAX_DEFORM_SMOOTHING as i64))]
-    smoothing: u32,
+    /// (Sec. 4.4; 0 keeps each vertex the mean of its triangles; at most 256), or `triangles`:
+    /// each triangle's own F, not smoothed (paper 000 Fig. 4 c).
+    #[arg(long, default_value = "1", value_parser = parse_smoothing)]
+    smoothing: Smoothing,
     /// Texels per side of the F map and the cut map (at most 4096).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_DEFORM_RES as i64))]
     res: u32,
@@ -64,7 +65,7 @@ impl MeshArgs {
             }
             (text, _) => parse_orientation(text)?,
         };
-        let maps = deformation_maps(&mesh, &orientation, self.smoothing as usize, self.res as usize, self.tile_size)
+        let maps = deformation_maps(&mesh, &orientation, self.smoothing, self.res as usize, self.tile_size)
             .map_err(|msg| Error::mesh(&self.mesh, msg))?;
         if maps.degenerate > 0 {
             eprintln!(
@@ -90,6 +91,17 @@ impl MeshArgs {
             );
         }
         Ok((mesh, maps, orientation, [loaded, start.elapsed().as_secs_f64() - loaded]))
+    }
+}
+
+/// Parse `triangles` or a number of rounds up to [`limits::MAX_DEFORM_SMOOTHING`].
+fn parse_smoothing(text: &str) -> std::result::Result<Smoothing, String> {
+    if text == "triangles" {
+        return Ok(Smoothing::Triangles);
+    }
+    match text.parse::<usize>() {
+        Ok(rounds) if rounds <= limits::MAX_DEFORM_SMOOTHING as usize => Ok(Smoothing::Vertices(rounds)),
+        _ => Err(format!("expected `triangles` or a number of rounds from 0 to {}", limits::MAX_DEFORM_SMOOTHING)),
     }
 }
 
@@ -165,7 +177,7 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     print_distortion(distortion(&mesh, |_| Mat2::IDENTITY), distortion(&mesh, |uv| field.at(uv)));
     let res = args.res;
     eprintln!(
-        "{}: {} triangles ({} mirrored in UV) in {} charts, {} rounds of smoothing ({} texels outside every triangle, \
+        "{}: {} triangles ({} mirrored in UV) in {} charts, smoothing {} ({} texels outside every triangle, \
          extrapolated from the nearest), \
          {} cut edges in {} cuts (bands for tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
          wrote f_map.exr, cuts.json, det_f.png, orientation.png, cut_bands.png to {}",
@@ -173,7 +185,10 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         mesh.indices.len(),
         maps.mirrored,
         maps.field.charts,
-        args.smoothing,
+        match args.smoothing {
+            Smoothing::Triangles => "none (each triangle's own F)".to_string(),
+            Smoothing::Vertices(rounds) => format!("per chart, {rounds} rounds"),
+        },
         maps.raster.filled,
         maps.cuts.edges.len(),
         maps.cuts.chains.len(),

@@ -1,6 +1,6 @@
 //! The deformation field of a UV-mapped mesh (paper 000 Sec. 4; DESIGN.md section 5): per
 //! triangle the deformation gradient and its polar decomposition, an orientation angle from a
-//! tangent field, the grid smoothing of Eq. 7, and the F map that a tiling-and-blending texture
+//! tangent field, its smoothing per chart (Sec. 4.4), and the F map that a tiling-and-blending texture
 //! reads (`deformation = [{ type = "map", ... }]`).
 
 pub mod analysis;
@@ -16,6 +16,7 @@ pub use analysis::{Analysis, AnalysisInput, analyze};
 pub use cuts::{CutEdge, Cuts, SeamPoint};
 pub use distortion::{Distortion, distortion};
 pub use field::{ChartField, FieldSample, TriangleRaster};
+
 pub use gradient::{TriangleDeformation, deformation_gradient};
 pub use overlap::{UvOverlap, uv_coverage, uv_overlap};
 
@@ -74,6 +75,17 @@ impl Orientation {
     }
 }
 
+/// How the field is smoothed before it is written to the F map (Sec. 4.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Smoothing {
+    /// Not at all: each texel takes its triangle's own F, which jumps at every edge (paper
+    /// 000 Fig. 4 c: the tiles' lookups F(u)(u - c) tear there).
+    Triangles,
+    /// Per chart on the surface: the UV vertices' means, then this many rounds of averaging
+    /// ([`ChartField`]).
+    Vertices(usize),
+}
+
 /// What `tessera deform` computes from a mesh.
 #[derive(Clone, Debug)]
 pub struct DeformationMaps {
@@ -113,13 +125,12 @@ impl DeformationMaps {
 }
 
 /// Derive the deformation field of `mesh` (which must have UVs): F = R(theta) S per triangle,
-/// smoothed per chart with `smoothing` rounds of vertex averaging ([`ChartField`]), written as
-/// a `res` x `res` F map; and the cut bands of its cuts for tiles of lattice spacing
+/// smoothed as `smoothing` says, written as a `res` x `res` F map; and the cut bands of its cuts for tiles of lattice spacing
 /// `tile_size`.
 pub fn deformation_maps(
     mesh: &TriangleMesh,
     orientation: &Orientation,
-    smoothing: usize,
+    smoothing: Smoothing,
     res: usize,
     tile_size: f32,
 ) -> Result<DeformationMaps, String> {
@@ -128,10 +139,14 @@ pub fn deformation_maps(
     if res == 0 {
         return Err("the maps need at least one texel per side".into());
     }
-    if smoothing > limits::MAX_DEFORM_SMOOTHING as usize || res > limits::MAX_DEFORM_RES as usize {
+    let rounds = match smoothing {
+        Smoothing::Triangles => 0,
+        Smoothing::Vertices(rounds) => rounds,
+    };
+    if rounds > limits::MAX_DEFORM_SMOOTHING as usize || res > limits::MAX_DEFORM_RES as usize {
         let (max_smoothing, max_res) = (limits::MAX_DEFORM_SMOOTHING, limits::MAX_DEFORM_RES);
         return Err(format!(
-            "{smoothing} smoothing rounds or maps {res} over tessera's limits of {max_smoothing} rounds and {max_res} per side"
+            "{rounds} smoothing rounds or maps {res} over tessera's limits of {max_smoothing} rounds and {max_res} per side"
         ));
     }
     if let Orientation::PerVertex(tangents) = orientation {
@@ -169,13 +184,17 @@ pub fn deformation_maps(
             Some((FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch }, d.mirrored()))
         })
         .collect();
-    let field = ChartField::new(mesh, &samples, smoothing).ok_or("every triangle is degenerate")?;
+    let field = ChartField::new(mesh, &samples, rounds).ok_or("every triangle is degenerate")?;
     let raster =
         TriangleRaster::new(res, &uv_triangles, |t| samples[t].is_none()).ok_or("every triangle is degenerate")?;
     let mut f_map = Bitmap::new(res, res, 4);
     for (k, &t) in raster.owner.iter().enumerate() {
-        let b = field::barycentric(raster.point(k), uv_triangles[t as usize]).unwrap_or(Vec3::ONE);
-        let f = field.at(t as usize, b);
+        let f = match (smoothing, samples[t as usize]) {
+            (Smoothing::Triangles, Some((sample, mirrored))) => sample.deformation(mirrored),
+            _ => {
+                field.at(t as usize, field::barycentric(raster.point(k), uv_triangles[t as usize]).unwrap_or(Vec3::ONE))
+            }
+        };
         f_map.values_mut(k % res, res - 1 - k / res).copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
     }
     let coverage = uv_coverage(&uv_triangles, res);
