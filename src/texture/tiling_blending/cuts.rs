@@ -146,6 +146,9 @@ pub const BANDS_PER_POINT: usize = 2;
 /// and for the arc length the row's weights use.
 const SEARCH: usize = 4;
 
+/// Most texel visits of the bands' rasterisation (a few seconds).
+const MAX_BAND_WORK: u64 = 1 << 28;
+
 /// Most tiles laid along all the cuts together (their anchors g(s_m) are precomputed).
 const MAX_CUT_TILES: usize = 1 << 24;
 
@@ -218,12 +221,16 @@ impl CutBands {
         };
         // Nearest candidates per texel, with their distances in tile spacings.
         let mut best = vec![[(NO_BAND, f32::INFINITY); BANDS_PER_POINT]; res * res];
+        // The texels each side's segments are searched over: around the segment, a band's
+        // extent in UV (a tile spacing through the smallest stretch of F at its ends, with
+        // room to spare), clamped to the square; counted first, so that cuts whose bands would
+        // cover the map many times over are refused rather than left to run for hours.
+        let mut boxes = Vec::new();
+        let mut work = 0u64;
         for (c, curve) in curves.iter().enumerate() {
             for side in 0..2 {
                 for (k, pair) in curve.points.windows(2).enumerate() {
                     let (a, b) = (pair[0].uv[side], pair[1].uv[side]);
-                    // The band's extent in UV: a tile spacing through the smallest stretch of F
-                    // at the segment's ends, with room to spare.
                     let sigma_min = [a, b]
                         .map(|p| {
                             let f = f_at(p.clamp(Vec2::ZERO, Vec2::ONE));
@@ -232,29 +239,37 @@ impl CutBands {
                         .into_iter()
                         .fold(f32::INFINITY, f32::min);
                     let extent = (2.0 * spacing[c] / sigma_min.max(1e-12)).min(0.5);
-                    // Points anywhere in a texel within the band: the texel's centre within the
-                    // band widened by half a texel's diagonal.
-                    let margin = |f: Mat2| {
-                        largest_singular_value(f) * std::f32::consts::FRAC_1_SQRT_2 / (res as f32 * spacing[c])
-                    };
                     let lo = ((a.min(b) - Vec2::splat(extent)) * res as f32).floor().max(Vec2::ZERO);
                     let hi = ((a.max(b) + Vec2::splat(extent)) * res as f32).ceil().min(Vec2::splat(res as f32));
-                    if !(lo.x < hi.x && lo.y < hi.y) {
+                    if lo.x < hi.x && lo.y < hi.y {
+                        work += ((hi.x - lo.x) * (hi.y - lo.y)) as u64;
+                        boxes.push((c, side, k, a, b, lo, hi));
+                    }
+                }
+            }
+        }
+        if work > MAX_BAND_WORK {
+            return Err(format!(
+                "the cut bands of tiles of {tile_size} would search {work} texels of the {res} x {res} map (at most \
+                 {MAX_BAND_WORK}): the tiles are too large for these cuts"
+            ));
+        }
+        for (c, side, k, a, b, lo, hi) in boxes {
+            // Points anywhere in a texel within the band: the texel's centre within the band
+            // widened by half a texel's diagonal.
+            let margin =
+                |f: Mat2| largest_singular_value(f) * std::f32::consts::FRAC_1_SQRT_2 / (res as f32 * spacing[c]);
+            for j in lo.y as usize..hi.y as usize {
+                for i in lo.x as usize..hi.x as usize {
+                    let uv = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
+                    let (_, p) = nearest_on_segment(uv, a, b);
+                    let f = f_at(uv);
+                    let d = (f * (uv - p)).length() / spacing[c];
+                    if d >= 1.0 + margin(f) {
                         continue;
                     }
-                    for j in lo.y as usize..hi.y as usize {
-                        for i in lo.x as usize..hi.x as usize {
-                            let uv = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
-                            let (_, p) = nearest_on_segment(uv, a, b);
-                            let f = f_at(uv);
-                            let d = (f * (uv - p)).length() / spacing[c];
-                            if d >= 1.0 + margin(f) {
-                                continue;
-                            }
-                            let candidate = (BandRef { curve: c as u32, segment_side: (k * 2 + side) as u32 }, d);
-                            insert_nearest(&mut best[(res - 1 - j) * res + i], candidate);
-                        }
-                    }
+                    let candidate = (BandRef { curve: c as u32, segment_side: (k * 2 + side) as u32 }, d);
+                    insert_nearest(&mut best[(res - 1 - j) * res + i], candidate);
                 }
             }
         }
@@ -390,6 +405,21 @@ mod tests {
         let [(_, _, o0), _] = near.tiles;
         let on = bands.at(Vec2::new(0.25, 0.5), Mat2::IDENTITY)[0].unwrap();
         assert!((o0 - on.tiles[0].2 - Vec2::new(0.05, 0.0)).length() < 1e-5);
+    }
+
+    #[test]
+    fn bands_that_would_cover_the_map_many_times_over_are_refused() {
+        // 400 segments whose bands, for tiles of 10 UV units, each cover most of the square.
+        let points = (0..=400)
+            .map(|k| {
+                let v = k as f32 / 400.0;
+                CutPoint { uv: [Vec2::new(0.25, v), Vec2::new(0.75, v)], s: v, g: Vec2::new(v, 0.0) }
+            })
+            .collect();
+        let curve = CutCurve::new(points, 1.0).unwrap();
+        let Err(error) = CutBands::new(vec![curve.clone()], &identity_map(1024), 10.0) else { panic!("accepted") };
+        assert!(error.contains("too large"), "{error}");
+        assert!(CutBands::new(vec![curve], &identity_map(1024), 0.01).is_ok());
     }
 
     #[test]
