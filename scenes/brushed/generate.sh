@@ -8,7 +8,7 @@ cargo build --release --locked
 for spec in "latlong scenes/meshes/smiley.obj parallels:0,0,1" "cube scenes/meshes/cube_sphere.obj parallels:0,1,0"; do
   set -- $spec
   out=$(mktemp -d)
-  ./target/release/tessera deform "$2" --orientation "$3" --tile-size 0.04 --res 512 -o "$out"
+  ./target/release/tessera deform "$2" --orientation "$3" --tile-size 0.04 --res 256 -o "$out"
   mkdir -p "scenes/brushed/maps/$1"
   cp "$out/f_map.exr" "$out/cuts.json" "scenes/brushed/maps/$1/"
   rm -r "$out"

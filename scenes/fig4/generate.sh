@@ -11,7 +11,7 @@ for spec in "stretch uv 1" "triangles parallels:1,0,1 triangles" "smoothed paral
   set -- $spec
   out=$(mktemp -d)
   ./target/release/tessera deform scenes/meshes/smiley.obj --orientation "$2" --smoothing "$3" --tile-size 0.05 \
-    --res 512 -o "$out"
+    --res 256 -o "$out"
   mkdir -p "scenes/fig4/maps/$1"
   cp "$out/f_map.exr" "scenes/fig4/maps/$1/"
   rm -r "$out"
