@@ -266,7 +266,10 @@ impl Material {
     /// then to a `pbr` material's anisotropy direction. With a normal map, the map's normal is read in that frame and the tangent s re-projected
     /// onto its plane (Mitsuba's `normalmap`).
     pub fn shading(&self, textures: &[Texture], ctx: &TexCtx, base: Frame, dpdu: Vec3, dpdv: Vec3) -> Shading {
-        let base = match self.texture_frame.and_then(|id| textures[id.0 as usize].tangent_direction(ctx.uv)) {
+        let base = match self
+            .texture_frame
+            .and_then(|id| textures[id.0 as usize].tangent_direction(ctx.uv, ctx.uv_mirrored))
+        {
             Some((direction, f_reversed)) => {
                 // The exemplar's frame reaches the surface through J F^-1: mirrored when exactly
                 // one of F and the UV map (as seen from this side) reverses orientation.

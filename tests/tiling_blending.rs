@@ -329,7 +329,7 @@ fn footprint_is_f_times_the_pixel_footprint_as_finite_differences_say() {
         for i in 0..500 {
             let uv = Sampler::new(2, i, 0).next_2d() * 4.0;
             let d = (Sampler::new(3, i, 0).next_2d() - 0.5) * 1e-3;
-            let ctx = TexCtx { uv, duv_dx: d, duv_dy: d.perp() };
+            let ctx = TexCtx { uv, duv_dx: d, duv_dy: d.perp(), uv_mirrored: None };
             let (here, _) = s.lookups(&ctx);
             let (there, _) = s.lookups(&TexCtx { uv: uv + d, ..ctx });
             let f = s.deformation_at(uv);

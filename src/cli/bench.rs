@@ -252,7 +252,7 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
             let uv = (Vec2::new((i % 1024) as f32, (i / 1024) as f32) + s.next_2d()) * (4.0 / 1024.0);
             let width = (4.0 / 1024.0) * 0.25 * 16f32.powf(s.next_1d());
             let dx = Vec2::from_angle(s.next_1d() * std::f32::consts::TAU) * width;
-            TexCtx { uv, duv_dx: dx, duv_dy: dx.perp() * (0.3 + 0.7 * s.next_1d()) }
+            TexCtx { uv, duv_dx: dx, duv_dy: dx.perp() * (0.3 + 0.7 * s.next_1d()), uv_mirrored: None }
         })
         .collect();
     let bitmap = lookups_per_second(runs, &exemplar, &lookups);

@@ -78,7 +78,9 @@ impl MeshArgs {
         if overlap.overlapped > 0 {
             eprintln!(
                 "warning: {}: {:.2}% of the UV area is covered by more than one triangle (overlapping UV islands): \
-                 the F map holds one deformation per texel, so those parts of the surface share one",
+                 the F map holds one deformation per texel, the unmirrored island's; a mirrored island on it reads it \
+                 mirrored (exact for mirror-image halves under a mirror-symmetric orientation field), any other \
+                 shares it as it is",
                 self.mesh.display(),
                 100.0 * overlap.fraction()
             );

@@ -83,12 +83,13 @@ pub struct AngleError {
 }
 
 /// The angle between the texture's x axis on the surface, J F^-1 e1 with F from `f_at` at each
-/// triangle's UV centroid, and the orientation field's direction on each triangle. None for
+/// triangle's UV centroid (given whether the triangle's UVs are mirrored, as the renderer
+/// knows at a hit), and the orientation field's direction on each triangle. None for
 /// [`Orientation::Uv`] or where no triangle has both.
 pub fn orientation_error(
     mesh: &TriangleMesh,
     orientation: &Orientation,
-    f_at: impl Fn(Vec2) -> Mat2,
+    f_at: impl Fn(Vec2, bool) -> Mat2,
 ) -> Option<AngleError> {
     let uvs = mesh.uvs.as_ref()?;
     let mut angles: Vec<(f64, f64)> = Vec::new();
@@ -98,7 +99,8 @@ pub fn orientation_error(
         let u = idx.map(|i| uvs[i as usize]);
         let Some(j) = super::deformation_gradient(x, u) else { continue };
         let normal = (x[1] - x[0]).cross(x[2] - x[0]);
-        let f = f_at((u[0] + u[1] + u[2]) / 3.0);
+        let mirrored = (u[1] - u[0]).perp_dot(u[2] - u[0]) < 0.0;
+        let f = f_at((u[0] + u[1] + u[2]) / 3.0, mirrored);
         if !(f.determinant().abs() > 1e-12) {
             continue;
         }
@@ -322,7 +324,9 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
         distortion_deformed: distortion(mesh, |uv| field.at(uv)),
         seams,
         seam_samples: samples,
-        orientation_error: orientation_error(mesh, input.orientation, |uv| field.at(uv)),
+        orientation_error: orientation_error(mesh, input.orientation, |uv, mirrored| {
+            field.at_surface(uv, Some(mirrored))
+        }),
         // A hexagonal tile reaches one lattice spacing from its centre.
         fold_over: fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), input.tile_size),
         uv_overlap: maps.overlap().fraction(),

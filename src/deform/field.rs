@@ -203,9 +203,16 @@ pub struct TriangleRaster {
 }
 
 impl TriangleRaster {
-    /// Rasterise `uv_triangles`, leaving out those with `skip[t]` (degenerate ones). None when
-    /// every triangle is skipped.
-    pub fn new(res: usize, uv_triangles: &[[Vec2; 3]], skip: impl Fn(usize) -> bool) -> Option<Self> {
+    /// Rasterise `uv_triangles`, leaving out those with `skip[t]` (degenerate ones). Where
+    /// triangles overlap in UV, one with `preferred[t]` keeps a texel from later ones without
+    /// (so that overlapping mirrored islands leave one island's field, not a patchwork of both).
+    /// None when every triangle is skipped.
+    pub fn new(
+        res: usize,
+        uv_triangles: &[[Vec2; 3]],
+        skip: impl Fn(usize) -> bool,
+        preferred: impl Fn(usize) -> bool,
+    ) -> Option<Self> {
         let mut owner = vec![NONE; res * res];
         let point = |i: usize, j: usize| Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
         for (t, tri) in uv_triangles.iter().enumerate() {
@@ -221,7 +228,9 @@ impl TriangleRaster {
             };
             for j in range(lo.y, hi.y) {
                 for i in range(lo.x, hi.x) {
-                    if barycentric(point(i, j), *tri).is_some_and(|b| b.min_element() >= -1e-6) {
+                    let inside = barycentric(point(i, j), *tri).is_some_and(|b| b.min_element() >= -1e-6);
+                    let kept = owner[j * res + i] != NONE && preferred(owner[j * res + i] as usize) && !preferred(t);
+                    if inside && !kept {
                         owner[j * res + i] = t as u32;
                     }
                 }

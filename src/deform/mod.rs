@@ -185,8 +185,11 @@ pub fn deformation_maps(
         })
         .collect();
     let field = ChartField::new(mesh, &samples, rounds).ok_or("every triangle is degenerate")?;
-    let raster =
-        TriangleRaster::new(res, &uv_triangles, |t| samples[t].is_none()).ok_or("every triangle is degenerate")?;
+    // Overlapping islands: the unmirrored one's field is kept; the renderer mirrors it for the
+    // other (DeformationField::at_surface).
+    let unmirrored = |t: usize| samples[t].is_some_and(|s| !s.1);
+    let raster = TriangleRaster::new(res, &uv_triangles, |t| samples[t].is_none(), unmirrored)
+        .ok_or("every triangle is degenerate")?;
     let mut f_map = Bitmap::new(res, res, 4);
     for (k, &t) in raster.owner.iter().enumerate() {
         let f = match (smoothing, samples[t as usize]) {

@@ -29,7 +29,7 @@ pub fn bake(texture: &Texture, res: usize, footprint: BakeFootprint) -> Bitmap {
         let v = (res - 1 - row) as f32 + 0.5;
         for (col, px) in line.chunks_exact_mut(4).enumerate() {
             let uv = Vec2::new(col as f32 + 0.5, v) / res as f32;
-            let ctx = TexCtx { uv, duv_dx: Vec2::new(step, 0.0), duv_dy: Vec2::new(0.0, step) };
+            let ctx = TexCtx { uv, duv_dx: Vec2::new(step, 0.0), duv_dy: Vec2::new(0.0, step), uv_mirrored: None };
             px.copy_from_slice(&texture.eval(&ctx).to_array());
         }
     });

@@ -24,6 +24,11 @@ pub struct TexCtx {
     pub duv_dx: Vec2,
     /// Change of uv for a one-pixel step in y.
     pub duv_dy: Vec2,
+    /// Whether the UV map reverses the surface's orientation here ((dp/du x dp/dv) . n < 0, n
+    /// the triangle's winding normal); None where no surface is known (bakes, exemplars). A
+    /// deformation field whose F map holds the other handedness there (overlapping mirrored UV
+    /// islands) is mirrored to match ([`tiling_blending::DeformationField::at_surface`]).
+    pub uv_mirrored: Option<bool>,
 }
 
 /// Which value of a texture a scalar parameter reads.
@@ -123,9 +128,9 @@ impl Texture {
 
     /// Where a deformation field orients the texture: the UV direction of the texture's own x
     /// axis at `uv` and whether the field reverses orientation (DESIGN.md section 3).
-    pub fn tangent_direction(&self, uv: Vec2) -> Option<(Vec2, bool)> {
+    pub fn tangent_direction(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Option<(Vec2, bool)> {
         match self {
-            Texture::TilingBlending(t) => t.tangent_direction(uv),
+            Texture::TilingBlending(t) => t.tangent_direction(uv, uv_mirrored),
             _ => None,
         }
     }

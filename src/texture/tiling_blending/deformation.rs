@@ -100,10 +100,37 @@ impl DeformationField {
         }
     }
 
-    /// The first F map factor at `uv` (None without one): the field whose units cut bands
-    /// measure in.
-    pub fn map_at(&self, uv: Vec2) -> Option<Mat2> {
-        self.factors.iter().find(|f| matches!(f, Deformation::Map(_))).map(|f| bounded(f.at(uv)))
+    /// F at `uv` on a surface whose UV map reverses orientation there or not (`uv_mirrored`;
+    /// None, no surface known, is [`DeformationField::at`]):
+    /// where the first F map factor has the other handedness (det < 0 against a surface that is
+    /// not mirrored, or the reverse: the map holds the field of an overlapping mirrored UV
+    /// island), that factor is mirrored, M F_map with M = diag(1, -1). For the two halves of a
+    /// mirror-symmetric mesh sharing their UVs, under an orientation field that is symmetric
+    /// too, M F_map is exactly the other half's field (DESIGN.md section 5); elsewhere the
+    /// handedness always agrees and this is [`DeformationField::at`].
+    pub fn at_surface(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Mat2 {
+        let Some(uv_mirrored) = uv_mirrored else { return self.at(uv) };
+        let mut flipped = false;
+        let mut product = Mat2::IDENTITY;
+        for f in &self.factors {
+            let mut m = bounded(f.at(uv));
+            if matches!(f, Deformation::Map(_)) && !flipped {
+                flipped = true;
+                if (m.determinant() < 0.0) != uv_mirrored {
+                    m = Mat2::from_diagonal(Vec2::new(1.0, -1.0)) * m;
+                }
+            }
+            product = bounded(product * m);
+        }
+        product
+    }
+
+    /// The first F map factor at `uv` (None without one), mirrored as
+    /// [`DeformationField::at_surface`] does: the field whose units cut bands measure in.
+    pub fn map_at(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Option<Mat2> {
+        let m = bounded(self.factors.iter().find(|f| matches!(f, Deformation::Map(_)))?.at(uv));
+        let flip = uv_mirrored.is_some_and(|mirrored| (m.determinant() < 0.0) != mirrored);
+        Some(if flip { Mat2::from_diagonal(Vec2::new(1.0, -1.0)) * m } else { m })
     }
 
     /// The first F map factor's texels (None without one).

@@ -172,7 +172,7 @@ mod tests {
         let n = 64;
         for (x, y) in [(3, 5), (17, 40), (63, 0), (31, 31)] {
             let st = Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
-            let ctx = TexCtx { uv: Vec2::new(st.x, 1.0 - st.y), duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO };
+            let ctx = TexCtx { uv: Vec2::new(st.x, 1.0 - st.y), ..Default::default() };
             let back = g.invert(g.eval(&ctx), &ctx).x;
             let original = ex.eval(&ctx).x;
             // The table's resolution limits the round trip.

@@ -165,7 +165,7 @@ impl Synthesis {
     pub fn lookups(&self, ctx: &TexCtx) -> ([TileLookup; MAX_LOOKUPS], usize) {
         let k = self.tiles_per_point();
         let tiles = self.tiling.tiles(ctx.uv, self.tile_size);
-        let f = self.deformation.as_ref().map(|d| d.at(ctx.uv));
+        let f = self.deformation.as_ref().map(|d| d.at_surface(ctx.uv, ctx.uv_mirrored));
         let mut out = [TileLookup::default(); MAX_LOOKUPS];
         for i in 0..k {
             let tile = &tiles[i];
@@ -174,8 +174,10 @@ impl Synthesis {
             let offset = ctx.uv - tile.centre;
             out[i].weight = tile.weight;
             out[i].ctx = match f {
-                None => TexCtx { uv: offset + h, ..*ctx },
-                Some(f) => TexCtx { uv: f * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy },
+                None => TexCtx { uv: offset + h, uv_mirrored: None, ..*ctx },
+                Some(f) => {
+                    TexCtx { uv: f * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy, uv_mirrored: None }
+                }
             };
         }
         let count = k + self.band_lookups(ctx, f.unwrap_or(Mat2::IDENTITY), &mut out);
@@ -187,7 +189,7 @@ impl Synthesis {
     #[inline]
     fn band_lookups(&self, ctx: &TexCtx, f: Mat2, out: &mut [TileLookup; MAX_LOOKUPS]) -> usize {
         let (Some(cuts), Some(field)) = (&self.cuts, &self.deformation) else { return 0 };
-        let Some(f_map) = field.map_at(ctx.uv) else { return 0 };
+        let Some(f_map) = field.map_at(ctx.uv, ctx.uv_mirrored) else { return 0 };
         let bands = cuts.at(ctx.uv, f_map);
         if bands.iter().all(Option::is_none) || !(f_map.determinant().abs() > 1e-20) {
             return 0;
@@ -220,7 +222,12 @@ impl Synthesis {
                 let h = cut_shift(band.curve, m, self.seed);
                 let h = if self.inset { inset_shift(h, Vec2::splat(band.reach * stretch)) } else { h };
                 out[k + n] = TileLookup {
-                    ctx: TexCtx { uv: other * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy },
+                    ctx: TexCtx {
+                        uv: other * offset + h,
+                        duv_dx: f * ctx.duv_dx,
+                        duv_dy: f * ctx.duv_dy,
+                        uv_mirrored: None,
+                    },
                     weight: tile_weight * w / total,
                 };
                 n += 1;
@@ -436,11 +443,12 @@ impl TilingBlending {
         Vec3::new(slope.x, slope.y, 1.0).try_normalize()
     }
 
-    /// The direction in UV of the exemplar's x axis at `uv`: F(u)^-1 e1 (DESIGN.md section 3),
-    /// and whether F reverses orientation. None without a deformation field or where F is
-    /// singular.
-    pub fn tangent_direction(&self, uv: Vec2) -> Option<(Vec2, bool)> {
-        let f = self.synthesis.deformation.as_ref()?.at(uv);
+    /// The direction in UV of the exemplar's x axis at `uv` on a surface whose UV map is
+    /// `uv_mirrored` or not: F(u)^-1 e1 (DESIGN.md section 3; F as
+    /// [`DeformationField::at_surface`] gives it), and whether F reverses orientation. None
+    /// without a deformation field or where F is singular.
+    pub fn tangent_direction(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Option<(Vec2, bool)> {
+        let f = self.synthesis.deformation.as_ref()?.at_surface(uv, uv_mirrored);
         let det = f.determinant();
         if !(det.abs() > 1e-12) {
             return None;
