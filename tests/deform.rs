@@ -389,3 +389,19 @@ fn overlapping_mirrored_islands_keep_one_field_and_the_other_half_mirrors_it() {
     // The -x face: a sixth of the sphere.
     assert!((without - 1.0 / 6.0).abs() < 0.02, "{without}");
 }
+
+#[test]
+fn deform_warns_about_cuts_that_no_band_closes() {
+    // The lat-long icosphere's pole fans are UV singularities: cuts of their own, one edge each.
+    let dir = tempfile::tempdir().unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("deform")
+        .arg(common::repo().join("scenes/meshes/smiley.obj"))
+        .args(["--orientation", "parallels:0,0,1", "--tile-size", "0.1", "--res", "64", "-o"])
+        .arg(dir.path().join("maps"))
+        .output()
+        .unwrap();
+    assert!(run.status.success());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("8 cut edges are UV singularities"), "{stderr}");
+}

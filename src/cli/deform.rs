@@ -92,6 +92,26 @@ impl MeshArgs {
                 maps.cuts.non_manifold
             );
         }
+        let singular = maps.cuts.edges.iter().filter(|e| e.is_singular()).count();
+        let banded: usize = maps.bands.curves().iter().map(|c| c.points().len() - 1).sum();
+        if maps.cuts.edges.len() > banded && singular > 0 {
+            eprintln!(
+                "warning: {}: {} cut edges are UV singularities (fans around a pole, a dart's tip) that make cuts of \
+                 their own; no band closes them, and the texture can show a seam there",
+                self.mesh.display(),
+                maps.cuts.edges.len() - banded
+            );
+        }
+        let fold = analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), self.tile_size);
+        if fold.folded > 0.01 {
+            eprintln!(
+                "warning: {}: tiles of {} fold their lookups F(u)(u - c) on {:.1}% of the texels (F varies across a \
+                 tile faster than a tile can follow: the texture tears there); smaller tiles fold less",
+                self.mesh.display(),
+                self.tile_size,
+                100.0 * fold.folded
+            );
+        }
         Ok((mesh, maps, orientation, [loaded, start.elapsed().as_secs_f64() - loaded]))
     }
 }
