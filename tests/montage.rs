@@ -1,4 +1,5 @@
-//! `tessera montage`: images on a labelled grid, and clear errors for what it cannot do.
+//! `tessera montage` and `tessera seams`: images on a labelled grid, the seam visibility of a
+//! render, and clear errors for what they cannot do.
 
 mod common;
 
@@ -30,4 +31,18 @@ fn montage_grids_images_and_refuses_bad_requests() {
     let bad_format = montage(&[a, "-o", "n.bmp"], dir.path());
     assert!(!bad_format.status.success());
     assert!(!dir.path().join("n.png").exists() && !dir.path().join("n.bmp").exists());
+}
+
+#[test]
+fn seams_reads_the_render_aovs_and_names_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    // A render without AOVs: the error names the file and the channel it lacks.
+    let plain = dir.path().join("plain.exr");
+    let grey = vec![0.5f32; 16];
+    let channels = ["R", "G", "B"].iter().map(|c| (c.to_string(), grey.clone())).collect();
+    tessera::image::write_exr(&plain, 4, 4, channels).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_tessera")).arg("seams").arg(&plain).output().unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("plain.exr") && stderr.contains("uv.U"), "{stderr}");
 }

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Render the four Fig. 8 scenes of this folder and lay them out as paper 000's Fig. 8:
 # parameterisations in rows, classical and deformed tiling and blending in columns, written to
-# the folder given (default: target/fig8). Also prints relMSE between the two
-# parameterisations' renders, classical and deformed (deformed should be nearly independent
-# of the parameterisation). Run from anywhere.
+# the folder given (default: target/fig8). Also prints each render's seam visibility (`tessera
+# seams`) and relMSE between the two parameterisations' renders, classical and deformed
+# (deformed should be nearly independent of the parameterisation). Run from anywhere.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 out=${1:-target/fig8}
@@ -11,7 +11,8 @@ spp=${SPP:-64}
 mkdir -p "$out"
 cargo build --release --locked
 for scene in latlong_classical latlong_deformed cube_classical cube_deformed; do
-  ./target/release/tessera render "scenes/brushed/$scene.toml" --spp "$spp" -q -o "$out/$scene.exr"
+  ./target/release/tessera render "scenes/brushed/$scene.toml" --spp "$spp" -q --aov uv,normal -o "$out/$scene.exr"
+  echo "$scene: $(./target/release/tessera seams "$out/$scene.exr")"
 done
 ./target/release/tessera montage --columns 2 \
   "$out/latlong_classical.exr" --label "lat-long, classical" \

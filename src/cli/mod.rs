@@ -100,6 +100,17 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// How visible the UV cuts are in a render made with `--aov uv,normal`: the mean radiance
+    /// difference of neighbouring pixels across a cut over that within a chart (about 1: the cut
+    /// does not show).
+    Seams {
+        /// The render (EXR with the uv and normal AOVs).
+        render: PathBuf,
+        /// A jump of the texture coordinates between neighbouring pixels larger than this is a
+        /// cut (UV units).
+        #[arg(long, default_value_t = 0.05, value_parser = positive_uv_length)]
+        jump: f32,
+    },
     /// Write a scene as Mitsuba 3 XML (meshes as OBJ, textures baked to EXR) to render it there.
     ExportMitsuba {
         /// Scene file (TOML).
@@ -213,6 +224,20 @@ pub fn run() -> Result<ExitCode> {
             montage(&images, columns as usize, &labels, &output)?;
             Ok(ExitCode::SUCCESS)
         }
+        Command::Seams { render, jump } => {
+            let radiance = tessera::image::read_exr_channels(&render, &["R", "G", "B"])?;
+            let uv = tessera::image::read_exr_channels(&render, Aov::Uv.channel_names())?;
+            let normal = tessera::image::read_exr_channels(&render, Aov::Normal.channel_names())?;
+            match tessera::image::seam_visibility(&radiance, &uv, &normal, jump) {
+                Some(v) => println!(
+                    "seam visibility {:.3}: mean |L_p - L_q| of neighbouring pixels across UV cuts ({} pairs) over \
+                     within charts ({} pairs)",
+                    v.ratio, v.across, v.within
+                ),
+                None => println!("seam visibility: no neighbouring pixels across a UV cut (jump {jump}) in view"),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Command::ExportMitsuba { scene, output, spp, bake_res } => {
             let scene = load(&scene, &SceneOverrides { spp, ..Default::default() }, false)?;
             let export = tessera::scene::export_mitsuba(&scene, &output, bake_res as usize)?;
@@ -288,6 +313,14 @@ fn non_negative(text: &str) -> std::result::Result<f64, String> {
     match text.parse::<f64>() {
         Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
         _ => Err(format!("'{text}' is not a finite number >= 0")),
+    }
+}
+
+/// A UV length in (0, 10].
+fn positive_uv_length(text: &str) -> std::result::Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(x) if x > 0.0 && x <= 10.0 => Ok(x),
+        _ => Err(format!("'{text}' is not a UV length in (0, 10]")),
     }
 }
 

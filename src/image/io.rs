@@ -151,7 +151,11 @@ fn check_exr_header(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
-fn read_exr(path: &Path) -> Result<Bitmap> {
+/// The named channels of an OpenEXR layer.
+type NamedPlanes = Vec<(String, Vec<f32>)>;
+
+/// The channels of an OpenEXR file's first valid layer, by name, with its size.
+fn decode_exr(path: &Path) -> Result<(usize, usize, NamedPlanes)> {
     use exr::prelude::traits::*;
     let bytes = read_bounded(path, limits::MAX_IMAGE_FILE_BYTES, "an image file")?;
     check_exr_header(path, &bytes)?;
@@ -167,8 +171,26 @@ fn read_exr(path: &Path) -> Result<Bitmap> {
     })?;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
-    let channels = &layer.channel_data.list;
-    let find = |name: &str| channels.iter().position(|c| c.name.to_string().eq_ignore_ascii_case(name));
+    let channels =
+        layer.channel_data.list.iter().map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect())).collect();
+    Ok((w, h, channels))
+}
+
+/// Interleave planes into a bitmap.
+fn interleave(w: usize, h: usize, planes: &[&Vec<f32>]) -> Bitmap {
+    let n = planes.len();
+    let mut data = vec![0.0; w * h * n];
+    for (c, plane) in planes.iter().enumerate() {
+        for (p, v) in plane.iter().enumerate() {
+            data[p * n + c] = *v;
+        }
+    }
+    Bitmap { width: w, height: h, channels: n, data }
+}
+
+fn read_exr(path: &Path) -> Result<Bitmap> {
+    let (w, h, channels) = decode_exr(path)?;
+    let find = |name: &str| channels.iter().position(|c| c.0.eq_ignore_ascii_case(name));
     // RGB(A) by name; else luminance; else the first four channels in the file's (sorted) order.
     let order: Vec<usize> = match (find("R"), find("G"), find("B"), find("Y")) {
         (Some(r), Some(g), Some(b), _) => [Some(r), Some(g), Some(b), find("A")].into_iter().flatten().collect(),
@@ -178,15 +200,24 @@ fn read_exr(path: &Path) -> Result<Bitmap> {
     if order.is_empty() {
         return Err(Error::image(path, "the OpenEXR file has no channels"));
     }
-    let planes: Vec<Vec<f32>> = order.iter().map(|&i| channels[i].sample_data.values_as_f32().collect()).collect();
-    let n = order.len();
-    let mut data = vec![0.0; w * h * n];
-    for (c, plane) in planes.iter().enumerate() {
-        for (p, v) in plane.iter().enumerate() {
-            data[p * n + c] = *v;
-        }
-    }
-    Ok(Bitmap { width: w, height: h, channels: n, data })
+    Ok(interleave(w, h, &order.iter().map(|&i| &channels[i].1).collect::<Vec<_>>()))
+}
+
+/// The channels `names` (at most four, e.g. a render's AOVs "uv.U", "uv.V") of an OpenEXR
+/// file, in that order; an error naming the file and the missing channel otherwise.
+pub fn read_exr_channels(path: &Path, names: &[&str]) -> Result<Bitmap> {
+    assert!((1..=4).contains(&names.len()));
+    let (w, h, channels) = decode_exr(path)?;
+    let planes = names
+        .iter()
+        .map(|name| {
+            channels.iter().find(|c| c.0 == *name).map(|c| &c.1).ok_or_else(|| {
+                let present: Vec<&str> = channels.iter().map(|c| c.0.as_str()).collect();
+                Error::image(path, format!("no channel '{name}' (the file has {})", present.join(", ")))
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(interleave(w, h, &planes))
 }
 
 /// Write named float channels (each `width * height` values, row 0 at the top) to an OpenEXR

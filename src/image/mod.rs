@@ -7,8 +7,12 @@ pub mod compare;
 mod film;
 mod io;
 mod montage;
+mod seams;
 
 pub use bitmap::{Bitmap, ColorSpace};
 pub use film::{Aov, Film, PixelSum};
-pub use io::{OutputFormat, decode_image, read_bitmap, read_bitmap_raw, write_exr, write_image, write_png};
+pub use io::{
+    OutputFormat, decode_image, read_bitmap, read_bitmap_raw, read_exr_channels, write_exr, write_image, write_png,
+};
 pub use montage::montage;
+pub use seams::{SeamVisibility, seam_visibility};
