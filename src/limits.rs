@@ -56,7 +56,7 @@ pub const MAX_THREADS: usize = 1024;
 /// floats, 3.2 GiB at the peak of writing it.
 pub const MAX_BAKE_RES: u32 = 8192;
 
-/// Largest side of the F map and cut map of `tessera deform` (`--res`): 256 MiB per map, 1.9 GiB
+/// Largest side of the F map of `tessera deform` (`--res`): 256 MiB per map, 1.9 GiB
 /// at the peak with the pictures.
 pub const MAX_DEFORM_RES: u32 = 4096;
 

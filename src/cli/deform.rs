@@ -1,4 +1,4 @@
-//! `tessera deform` and `tessera analyze`: the deformation field and cut map of a UV-mapped mesh
+//! `tessera deform` and `tessera analyze`: the deformation field and cuts of a UV-mapped mesh
 //! (paper 000 Sec. 4 and 5), and the distortion and seam metrics they are judged by.
 
 use clap::Args;
@@ -29,7 +29,7 @@ pub struct MeshArgs {
     /// each triangle's own F, not smoothed (paper 000 Fig. 4 c).
     #[arg(long, default_value = "1", value_parser = parse_smoothing)]
     smoothing: Smoothing,
-    /// Texels per side of the F map and the cut map (at most 4096).
+    /// Texels per side of the F map (and of the cut bands' raster; at most 4096).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_DEFORM_RES as i64))]
     res: u32,
     /// Tangent field orienting the texture: `uv` (F = S), `fixed:X,Y,Z` (a direction projected

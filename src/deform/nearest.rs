@@ -1,5 +1,5 @@
 //! The nearest-primitive fill of a square grid (paper 000 Sec. 6.1: "samples outside of these
-//! triangles ... take the value of the closest UV triangle"; the cut map's nearest cut edge):
+//! triangles ... take the value of the closest UV triangle"; here the F map's texels):
 //! candidates propagate from neighbours in forward and backward raster sweeps, each point
 //! keeping the one nearest to it (the classic two-pass distance transform, run twice, with exact
 //! distances to the primitives).

@@ -164,9 +164,9 @@ pub struct TilingBlendingDesc {
     /// The deformation field F as a product of factors, F = F_1 F_2 ... (default: none, which
     /// is classical tiling and blending).
     pub deformation: Option<Vec<DeformationDesc>>,
-    /// A cut map written by `tessera deform` (`cut_map.exr`): tiles centred in a boundary cell
-    /// of a UV cut take the cell's centre and shift, so that the texture continues across the
-    /// cut (paper 000 Eq. 8). Made for the same `tile_size` as `tessera deform --tile-size`.
+    /// A cuts file written by `tessera deform` (`cuts.json`): near each UV cut a row of tiles
+    /// laid along it, read alike from both sides, so that the texture continues across the cut
+    /// (DESIGN.md section 6). Needs a `map` factor in `deformation`.
     pub cuts: Option<String>,
 }
 
