@@ -203,10 +203,14 @@ impl CutBands {
         let mut anchors = Vec::with_capacity(curves.len());
         let mut total = 0usize;
         for (c, h) in curves.iter().zip(&spacing) {
+            if !(h.is_finite() && *h > 0.0) {
+                return Err(format!("the tile size {tile_size} gives a cut of scale {} no tile spacing", c.scale));
+            }
             let (s0, s1) = (c.points[0].s, c.points[c.points.len() - 1].s);
-            let count = ((s1 - s0) / h).ceil() as usize + 2;
+            // A float cast saturates: an enormous ratio becomes usize::MAX, refused below.
+            let count = (((s1 - s0) / h).ceil() as usize).saturating_add(2);
             total = total.saturating_add(count);
-            if !(h.is_finite() && *h > 0.0) || total > MAX_CUT_TILES {
+            if total > MAX_CUT_TILES {
                 return Err(format!(
                     "the tile size {tile_size} lays more than {MAX_CUT_TILES} tiles along the cuts: too small for them"
                 ));
@@ -420,6 +424,16 @@ mod tests {
         let Err(error) = CutBands::new(vec![curve.clone()], &identity_map(1024), 10.0) else { panic!("accepted") };
         assert!(error.contains("too large"), "{error}");
         assert!(CutBands::new(vec![curve], &identity_map(1024), 0.01).is_ok());
+    }
+
+    #[test]
+    fn absurd_tile_sizes_are_refused_not_overflowed() {
+        let mut curve = straight_cut();
+        curve.scale = 1e-30;
+        let Err(error) = CutBands::new(vec![curve], &identity_map(16), 1e-20) else { panic!("accepted") };
+        assert!(error.contains("no tile spacing"), "{error}");
+        let Err(error) = CutBands::new(vec![straight_cut()], &identity_map(16), 1e-9) else { panic!("accepted") };
+        assert!(error.contains("too small"), "{error}");
     }
 
     #[test]
