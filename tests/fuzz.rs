@@ -44,8 +44,8 @@ static LIVE: AtomicUsize = AtomicUsize::new(0);
 static CURRENT_CASE: AtomicUsize = AtomicUsize::new(usize::MAX);
 /// Per kind of seed: cases run, and cases whose mutated input still loaded as a scene and was
 /// rendered (the fuzzer's depth).
-static CASES: [AtomicUsize; 5] = [const { AtomicUsize::new(0) }; 5];
-static RENDERED: [AtomicUsize; 5] = [const { AtomicUsize::new(0) }; 5];
+static CASES: [AtomicUsize; 6] = [const { AtomicUsize::new(0) }; 6];
+static RENDERED: [AtomicUsize; 6] = [const { AtomicUsize::new(0) }; 6];
 
 #[global_allocator]
 static ALLOCATOR: BudgetAllocator = BudgetAllocator;
@@ -361,6 +361,9 @@ enum Kind {
     Gltf,
     Glb,
     Image,
+    /// A cuts file of `tessera deform`, read by a tiling-and-blending texture with the lat-long
+    /// sphere's F map.
+    Cuts,
 }
 
 /// An input to mutate.
@@ -423,6 +426,7 @@ fn seeds() -> Vec<Seed> {
     let planes = ["A", "B", "G", "R"].map(|c| (c.to_string(), (0..30).map(|i| i as f32 * 0.03).collect()));
     tessera::image::write_exr(&exr, 6, 5, planes.into()).unwrap();
     seeds.push(file(Kind::Image, "small.exr", std::fs::read(&exr).unwrap()));
+    seeds.push(file(Kind::Cuts, "cuts.json", std::fs::read(root.join("scenes/maps/smiley/cuts.json")).unwrap()));
     seeds
 }
 
@@ -445,6 +449,21 @@ fn scene_using(kind: Kind, file: &str) -> String {
                 [camera]\nfov = 50\neye = [0.5, 0.5, 3]\ntarget = [0.5, 0.5, 0]\n";
     match kind {
         Kind::Obj => format!("{head}[[shapes]]\ntype = \"obj\"\nfilename = \"{file}\"\nemission = 1\n"),
+        Kind::Cuts => {
+            let root = common::repo().join("scenes");
+            let (f_map, mesh) = (root.join("maps/smiley/f_map.exr"), root.join("meshes/smiley.obj"));
+            format!(
+                "{head}[textures.e]\ntype = \"image\"\nfilename = \"{}\"\n\
+                 [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\ntile_size = 0.1\n\
+                 deformation = [{{ type = \"map\", filename = \"{}\" }}]\ncuts = \"{file}\"\n\
+                 [materials.m]\ntype = \"diffuse\"\nreflectance = \"tb\"\n\
+                 [[shapes]]\ntype = \"obj\"\nfilename = \"{}\"\nmaterial = \"m\"\n\
+                 [environment]\ntype = \"constant\"\nradiance = 1\n",
+                root.join("textures/brushed.png").display(),
+                f_map.display(),
+                mesh.display()
+            )
+        }
         Kind::Gltf | Kind::Glb => format!(
             "{head}[[shapes]]\ntype = \"gltf\"\nfilename = \"{file}\"\n[environment]\ntype = \"constant\"\nradiance = 1\n"
         ),
@@ -492,7 +511,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     CASES[seed.kind as usize].fetch_add(1, Ordering::Relaxed);
     let bytes = match seed.kind {
         Kind::Glb => mutate_glb(rng, &seed.bytes),
-        Kind::Gltf => mutate_json(rng, &String::from_utf8_lossy(&seed.bytes)),
+        Kind::Gltf | Kind::Cuts => mutate_json(rng, &String::from_utf8_lossy(&seed.bytes)),
         Kind::Scene | Kind::Obj => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
         Kind::Image => {
             let mut b = seed.bytes.clone();
@@ -515,6 +534,8 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
                 let _ = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 32, 0.25);
             }
         }
+    } else if seed.kind == Kind::Cuts {
+        let _ = tessera::texture::tiling_blending::cuts_from_json(&String::from_utf8_lossy(&bytes));
     } else {
         let _ = tessera::image::read_bitmap_raw(&file, ColorSpace::Srgb);
     }
@@ -579,7 +600,7 @@ fn fuzz_loaders_with_mutated_inputs() {
         }
     }
     worker.join().unwrap();
-    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image"]
+    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image", "cuts"]
         .iter()
         .enumerate()
         .map(|(k, name)| format!("{name} {}/{}", RENDERED[k].load(Ordering::Relaxed), CASES[k].load(Ordering::Relaxed)))
