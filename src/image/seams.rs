@@ -19,9 +19,13 @@ pub struct SeamVisibility {
 
 /// The seam visibility of `radiance` (RGB) given the render's `uv` (2 channels) and `normal`
 /// (3 channels) AOVs, all the same size. Neighbours (right and below) whose texture coordinates
-/// differ by more than `jump` are across a cut, by less than a quarter of it within a chart;
-/// pixels not wholly on the surface (an averaged normal shorter than 0.999) are left out. None
-/// without pairs of either kind.
+/// differ by more than `jump`, and by more than 8 times the steps one pixel further out along
+/// the same line on either side (one pixel out, since a pixel straddling the cut averages the
+/// two sides' coordinates and splits the jump in two), are across a cut; by less than a
+/// quarter of `jump`, within a chart.
+/// The steps keep out neighbours of one chart whose texture coordinates change fast (near a
+/// lat-long pole). Pixels not wholly on the surface (an averaged normal shorter than 0.999) are
+/// left out. None without pairs of either kind.
 pub fn seam_visibility(radiance: &Bitmap, uv: &Bitmap, normal: &Bitmap, jump: f32) -> Option<SeamVisibility> {
     let (w, h) = (radiance.width, radiance.height);
     if (uv.width, uv.height, normal.width, normal.height) != (w, h, w, h) || uv.channels < 2 || normal.channels < 3 {
@@ -42,12 +46,23 @@ pub fn seam_visibility(radiance: &Bitmap, uv: &Bitmap, normal: &Bitmap, jump: f3
             if !on_surface(x, y) {
                 continue;
             }
-            for (nx, ny) in [(x + 1, y), (x, y + 1)] {
+            for (dx, dy) in [(1, 0), (0, 1)] {
+                let (nx, ny) = (x + dx, y + dy);
                 if nx >= w || ny >= h || !on_surface(nx, ny) {
                     continue;
                 }
                 let d = uv_at(x, y).distance(uv_at(nx, ny));
-                let sum = if d > jump {
+                // The steps one pixel out before and after the pair along its line, where they
+                // are on the surface.
+                let step = |(ax, ay): (usize, usize), (bx, by): (usize, usize)| {
+                    (bx < w && by < h && on_surface(ax, ay) && on_surface(bx, by))
+                        .then(|| uv_at(ax, ay).distance(uv_at(bx, by)))
+                };
+                let before =
+                    (x >= 2 * dx && y >= 2 * dy).then(|| step((x - 2 * dx, y - 2 * dy), (x - dx, y - dy))).flatten();
+                let after = step((nx + dx, ny + dy), (nx + 2 * dx, ny + 2 * dy));
+                let local = before.unwrap_or(0.0).max(after.unwrap_or(0.0));
+                let sum = if d > jump && d > 8.0 * local {
                     &mut across
                 } else if d < jump / 4.0 {
                     &mut within
