@@ -100,9 +100,9 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
-    /// How visible the UV cuts are in a render made with `--aov uv,normal`: the mean radiance
-    /// difference of neighbouring pixels across a cut over that within a chart (about 1: the cut
-    /// does not show).
+    /// How visible the UV cuts are in a render made with `--aov uv,normal`: the radiance
+    /// difference of neighbouring pixels across a cut over that of the steps beside them (about
+    /// 1: the cut does not show).
     Seams {
         /// The render (EXR with the uv and normal AOVs).
         render: PathBuf,
@@ -230,9 +230,9 @@ pub fn run() -> Result<ExitCode> {
             let normal = tessera::image::read_exr_channels(&render, Aov::Normal.channel_names())?;
             match tessera::image::seam_visibility(&radiance, &uv, &normal, jump) {
                 Some(v) => println!(
-                    "seam visibility {:.3}: mean |L_p - L_q| of neighbouring pixels across UV cuts ({} pairs) over \
-                     within charts ({} pairs)",
-                    v.ratio, v.across, v.within
+                    "seam visibility {:.3}: |L_p - L_q| of neighbouring pixels across UV cuts ({} pairs) over that of \
+                     the neighbouring steps on either side",
+                    v.ratio, v.across
                 ),
                 None => println!("seam visibility: no neighbouring pixels across a UV cut (jump {jump}) in view"),
             }

@@ -1,31 +1,31 @@
-//! How visible a mesh's UV cuts are in a render (issue 20, Fig. 8): the mean radiance
-//! difference between neighbouring pixels on two sides of a cut (their texture coordinates
-//! jump), over that between neighbouring pixels of one chart. About 1: the cut shows no more
-//! than any two neighbouring pixels differ; well above 1: the cut is seen (a classical
-//! synthesis' seam, a highlight that breaks). Read from a render's `uv` and `normal` AOVs.
+//! How visible a mesh's UV cuts are in a render (issue 20, Fig. 8): the radiance difference
+//! between neighbouring pixels on two sides of a cut (their texture coordinates jump), over
+//! that between the pixels one step further out on either side, within each chart. About 1: the
+//! cut shows no more than the texture around it changes; well above 1: the cut is seen (a
+//! classical synthesis' seam, a highlight that breaks). Read from a render's `uv` and `normal`
+//! AOVs.
 
 use super::Bitmap;
 
 /// The figure and how many pixel pairs it rests on.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct SeamVisibility {
-    /// Mean |L_p - L_q| across cuts over the mean within charts.
+    /// Sum of |L_p - L_q| across cuts over the sum of the neighbouring steps' differences.
     pub ratio: f64,
     /// Neighbouring pixel pairs across a cut.
     pub across: usize,
-    /// Neighbouring pixel pairs within a chart.
-    pub within: usize,
 }
 
 /// The seam visibility of `radiance` (RGB) given the render's `uv` (2 channels) and `normal`
-/// (3 channels) AOVs, all the same size. Neighbours (right and below) whose texture coordinates
-/// differ by more than `jump`, and by more than 8 times the steps one pixel further out along
-/// the same line on either side (one pixel out, since a pixel straddling the cut averages the
-/// two sides' coordinates and splits the jump in two), are across a cut; by less than a
-/// quarter of `jump`, within a chart.
-/// The steps keep out neighbours of one chart whose texture coordinates change fast (near a
-/// lat-long pole). Pixels not wholly on the surface (an averaged normal shorter than 0.999) are
-/// left out. None without pairs of either kind.
+/// (3 channels) AOVs, all the same size. A pair of neighbours (right or below) is across a cut
+/// where its texture coordinates differ by more than `jump` and by more than 8 times the steps
+/// one pixel further out along the same line on either side (one pixel out, since a pixel
+/// straddling the cut averages the two sides' coordinates and splits the jump in two; the
+/// steps keep out neighbours of one chart whose coordinates change fast, near a lat-long pole).
+/// Its radiance difference is compared with those of the steps one pixel further out, which
+/// lie within a chart each: a local reference, so that a cut in a dark part of the image is not
+/// flattered by the bright highlight elsewhere. Pixels not wholly on the surface (an averaged
+/// normal shorter than 0.999) are left out. None without such pairs.
 pub fn seam_visibility(radiance: &Bitmap, uv: &Bitmap, normal: &Bitmap, jump: f32) -> Option<SeamVisibility> {
     let (w, h) = (radiance.width, radiance.height);
     if (uv.width, uv.height, normal.width, normal.height) != (w, h, w, h) || uv.channels < 2 || normal.channels < 3 {
@@ -40,45 +40,33 @@ pub fn seam_visibility(radiance: &Bitmap, uv: &Bitmap, normal: &Bitmap, jump: f3
         let (p, q) = (radiance.pixel(a.0, a.1), radiance.pixel(b.0, b.1));
         (((p - q).abs().truncate()).element_sum() / 3.0) as f64
     };
-    let (mut across, mut within) = ((0.0, 0usize), (0.0, 0usize));
+    let (mut across, mut around, mut pairs) = (0.0, 0.0, 0usize);
     for y in 0..h {
         for x in 0..w {
-            if !on_surface(x, y) {
-                continue;
-            }
-            for (dx, dy) in [(1, 0), (0, 1)] {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx >= w || ny >= h || !on_surface(nx, ny) {
+            for (dx, dy) in [(1usize, 0usize), (0, 1)] {
+                // The pixels a (two out), b, c (the pair), d (two out) along the line.
+                if x < 2 * dx || y < 2 * dy || x + 3 * dx >= w || y + 3 * dy >= h {
                     continue;
                 }
-                let d = uv_at(x, y).distance(uv_at(nx, ny));
-                // The steps one pixel out before and after the pair along its line, where they
-                // are on the surface.
-                let step = |(ax, ay): (usize, usize), (bx, by): (usize, usize)| {
-                    (bx < w && by < h && on_surface(ax, ay) && on_surface(bx, by))
-                        .then(|| uv_at(ax, ay).distance(uv_at(bx, by)))
-                };
-                let before =
-                    (x >= 2 * dx && y >= 2 * dy).then(|| step((x - 2 * dx, y - 2 * dy), (x - dx, y - dy))).flatten();
-                let after = step((nx + dx, ny + dy), (nx + 2 * dx, ny + 2 * dy));
-                let local = before.unwrap_or(0.0).max(after.unwrap_or(0.0));
-                let sum = if d > jump && d > 8.0 * local {
-                    &mut across
-                } else if d < jump / 4.0 {
-                    &mut within
-                } else {
+                let line = [-2i64, -1, 0, 1, 2, 3]
+                    .map(|k| ((x as i64 + k * dx as i64) as usize, (y as i64 + k * dy as i64) as usize));
+                if !line.iter().all(|&(px, py)| on_surface(px, py)) {
                     continue;
-                };
-                sum.0 += difference((x, y), (nx, ny));
-                sum.1 += 1;
+                }
+                let (b, c) = (line[2], line[3]);
+                let d = uv_at(b.0, b.1).distance(uv_at(c.0, c.1));
+                let before = uv_at(line[0].0, line[0].1).distance(uv_at(line[1].0, line[1].1));
+                let after = uv_at(line[4].0, line[4].1).distance(uv_at(line[5].0, line[5].1));
+                if !(d > jump && d > 8.0 * before.max(after)) {
+                    continue;
+                }
+                across += difference(b, c);
+                around += (difference(line[0], line[1]) + difference(line[4], line[5])) / 2.0;
+                pairs += 1;
             }
         }
     }
-    (across.1 > 0 && within.1 > 0 && within.0 > 0.0).then(|| SeamVisibility {
-        ratio: (across.0 / across.1 as f64) / (within.0 / within.1 as f64),
-        across: across.1,
-        within: within.1,
-    })
+    (pairs > 0 && around > 0.0).then(|| SeamVisibility { ratio: across / around, across: pairs })
 }
 
 #[cfg(test)]
