@@ -102,16 +102,6 @@ impl MeshArgs {
                 maps.cuts.edges.len() - banded
             );
         }
-        let fold = analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), self.tile_size);
-        if fold.folded > 0.01 {
-            eprintln!(
-                "warning: {}: tiles of {} fold their lookups F(u)(u - c) on {:.1}% of the texels (F varies across a \
-                 tile faster than a tile can follow: the texture tears there); smaller tiles fold less",
-                self.mesh.display(),
-                self.tile_size,
-                100.0 * fold.folded
-            );
-        }
         Ok((mesh, maps, orientation, [loaded, start.elapsed().as_secs_f64() - loaded]))
     }
 }
@@ -180,6 +170,17 @@ fn print_distortion(classical: Option<Distortion>, deformed: Option<Distortion>)
 /// `tessera deform`.
 pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     let (mesh, maps, _, [loaded, computed]) = args.maps()?;
+    // (`analyze` prints the fold-over among its figures.)
+    let fold = analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), args.tile_size);
+    if fold.folded > 0.01 {
+        eprintln!(
+            "warning: {}: tiles of {} fold their lookups F(u)(u - c) on {:.1}% of the texels (F varies across a tile \
+             faster than a tile can follow: the texture tears there); smaller tiles fold less",
+            args.mesh.display(),
+            args.tile_size,
+            100.0 * fold.folded
+        );
+    }
     // All five files or none: a failure halfway leaves the folder as it was.
     let staged = StagedFolder::new(output)?;
     let write_map = |name: &str, map: &tessera::image::Bitmap| {

@@ -23,11 +23,12 @@ pub struct FieldSample {
 }
 
 impl FieldSample {
-    /// F = R(theta) S, or R(theta) M S with M = diag(1, -1) where the UVs are `mirrored`
-    /// ([`super::TriangleDeformation::signed_stretch`]).
+    /// F = R(theta) S, or R(theta) M S with M = diag(1, -1) where the UVs are `mirrored`:
+    /// J F^-1 = R M R(-theta) is then a rotation of the exemplar's frame onto the surface and
+    /// the texture never shows mirrored (det F < 0 there; DESIGN.md section 5).
     pub fn deformation(&self, mirrored: bool) -> Mat2 {
         let d = self.direction.normalize_or(Vec2::X);
-        let m = if mirrored { Mat2::from_diagonal(Vec2::new(1.0, -1.0)) } else { Mat2::IDENTITY };
+        let m = if mirrored { crate::math::MIRROR } else { Mat2::IDENTITY };
         Mat2::from_cols(d, d.perp()) * m * self.stretch
     }
 }

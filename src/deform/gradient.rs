@@ -50,14 +50,6 @@ impl TriangleDeformation {
         self.rotation.determinant() < 0.0
     }
 
-    /// The stretch with the mirror M = diag(1, -1) in front where the UVs are mirrored: M S.
-    /// F = R(theta) M S then undoes the mirror, so that J F^-1 = R M R(-theta) is a rotation of
-    /// the exemplar's frame onto the surface and the texture never shows mirrored (det F < 0
-    /// there; DESIGN.md section 5).
-    pub fn signed_stretch(&self) -> Mat2 {
-        if self.mirrored() { Mat2::from_diagonal(Vec2::new(1.0, -1.0)) * self.stretch } else { self.stretch }
-    }
-
     /// The angle theta of F = R(theta) [M] S (Eq. 6 and Sec. 4.3; M where the UVs are mirrored)
     /// that turns the texture's own x axis onto the tangent `direction`: the x axis reaches the
     /// surface along J F^-1 e1 = R [M] R(-theta) e1, which is along `direction` when
@@ -73,6 +65,7 @@ impl TriangleDeformation {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::deform::FieldSample;
 
     #[test]
     fn gradient_of_an_affine_uv_map_is_that_map() {
@@ -110,7 +103,7 @@ mod tests {
         let n = (x[1] - x[0]).cross(x[2] - x[0]).normalize();
         for direction in [Vec3::X, Vec3::new(0.3, -1.0, 0.2), Vec3::Y + Vec3::Z] {
             let theta = d.orientation_angle(direction);
-            let f = Mat2::from_angle(theta) * d.signed_stretch();
+            let f = FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch }.deformation(d.mirrored());
             let along = f.inverse() * Vec2::X;
             let on_surface = (j * along.extend(0.0)).normalize();
             let tangent = (direction - n * n.dot(direction)).normalize();
@@ -129,7 +122,8 @@ mod tests {
         let j = deformation_gradient(x, u).unwrap();
         let n = (x[1] - x[0]).cross(x[2] - x[0]).normalize();
         for direction in [Vec3::X, Vec3::new(0.3, -1.0, 0.2)] {
-            let f = Mat2::from_angle(d.orientation_angle(direction)) * d.signed_stretch();
+            let f = FieldSample { direction: Vec2::from_angle(d.orientation_angle(direction)), stretch: d.stretch }
+                .deformation(d.mirrored());
             assert!(f.determinant() < 0.0);
             let inverse = f.inverse();
             let x_axis = j * (inverse * Vec2::X).extend(0.0);

@@ -125,6 +125,10 @@ pub fn normal_quantile(p: f64) -> f64 {
     x - u / (1.0 + x * u / 2.0)
 }
 
+/// M = diag(1, -1): the mirror of the texture's y axis that F = R(theta) M S puts in front of
+/// the stretch where a triangle's UVs are mirrored (DESIGN.md section 5).
+pub const MIRROR: glam::Mat2 = glam::Mat2::from_cols_array(&[1.0, 0.0, 0.0, -1.0]);
+
 /// The largest singular value of a 2x2 matrix (its spectral norm).
 pub fn largest_singular_value(m: glam::Mat2) -> f32 {
     let frobenius2 = m.x_axis.length_squared() + m.y_axis.length_squared();

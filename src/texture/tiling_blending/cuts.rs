@@ -290,9 +290,21 @@ impl CutBands {
     /// are in).
     #[inline]
     pub fn at(&self, uv: Vec2, f: Mat2) -> [Option<BandLookup>; BANDS_PER_POINT] {
+        self.texel(uv).map(|r| if r.curve == u32::MAX { None } else { self.band(r, uv, f) })
+    }
+
+    /// Whether `uv`'s texel is near a cut at all (before anything is evaluated there).
+    #[inline]
+    pub fn near(&self, uv: Vec2) -> bool {
+        self.texel(uv)[0].curve != u32::MAX
+    }
+
+    /// The cut sides recorded for the texel holding `uv` (clamped to the square).
+    #[inline]
+    fn texel(&self, uv: Vec2) -> [BandRef; BANDS_PER_POINT] {
         let i = ((uv.x * self.res as f32).max(0.0) as usize).min(self.res - 1);
         let j = (((1.0 - uv.y) * self.res as f32).max(0.0) as usize).min(self.res - 1);
-        self.texels[j * self.res + i].map(|r| if r.curve == u32::MAX { None } else { self.band(r, uv, f) })
+        self.texels[j * self.res + i]
     }
 
     fn band(&self, r: BandRef, uv: Vec2, f: Mat2) -> Option<BandLookup> {
@@ -303,14 +315,16 @@ impl CutBands {
         let last = curve.points.len() - 2;
         // The nearest point of this side's copy among the segments around the texel's: p, and
         // its g for the lookups.
-        let window = segment.saturating_sub(SEARCH)..=(segment + SEARCH).min(last);
-        let nearest: Vec<(f32, f32, Vec2, Vec2)> = window
-            .map(|k| {
-                let (a, b) = (&curve.points[k], &curve.points[k + 1]);
-                let (t, q) = nearest_on_segment(uv, a.uv[side], b.uv[side]);
-                (q.distance(uv), a.s + (b.s - a.s) * t, a.g.lerp(b.g, t), q)
-            })
-            .collect();
+        let first = segment.saturating_sub(SEARCH);
+        let count = (segment + SEARCH).min(last) + 1 - first;
+        // (distance, s, g, point) per segment of the window, on the stack: this runs per lookup.
+        let mut nearest = [(f32::INFINITY, 0.0f32, Vec2::ZERO, Vec2::ZERO); 2 * SEARCH + 1];
+        for (slot, k) in nearest.iter_mut().zip(first..first + count) {
+            let (a, b) = (&curve.points[k], &curve.points[k + 1]);
+            let (t, q) = nearest_on_segment(uv, a.uv[side], b.uv[side]);
+            *slot = (q.distance(uv), a.s + (b.s - a.s) * t, a.g.lerp(b.g, t), q);
+        }
+        let nearest = &nearest[..count];
         let &(closest, _, g, p) = nearest.iter().min_by(|a, b| a.0.total_cmp(&b.0)).expect("a segment");
         // The arc length for the row's weights: the nearest points' s, averaged over the
         // segments nearly as near as the nearest (weights falling to 0 at half again its
@@ -319,7 +333,7 @@ impl CutBands {
         // lookups do not either, being the same affine map g(s_p) + F (u - p) from both.
         let spread = 0.5 * closest + 1e-9;
         let (mut s_sum, mut w_sum) = (0.0f32, 0.0f32);
-        for &(d, s_k, _, _) in &nearest {
+        for &(d, s_k, _, _) in nearest {
             let w = (1.0 - (d - closest) / spread).max(0.0).powi(2);
             s_sum += w * s_k;
             w_sum += w;

@@ -75,6 +75,13 @@ fn bounded(m: Mat2) -> Mat2 {
     Mat2::from_cols_array(&m.to_cols_array().map(clamp))
 }
 
+/// An F map's value `m` mirrored, M m, where its handedness (det < 0 or not) is not the
+/// surface's (`uv_mirrored`; as it is without a surface).
+#[inline]
+fn with_handedness(m: Mat2, uv_mirrored: Option<bool>) -> Mat2 {
+    if uv_mirrored.is_some_and(|mirrored| (m.determinant() < 0.0) != mirrored) { crate::math::MIRROR * m } else { m }
+}
+
 /// A deformation field: the product F = F_1 F_2 ... F_n of its factors (identity when empty).
 #[derive(Clone, Debug, Default)]
 pub struct DeformationField {
@@ -109,28 +116,21 @@ impl DeformationField {
     /// too, M F_map is exactly the other half's field (DESIGN.md section 5); elsewhere the
     /// handedness always agrees and this is [`DeformationField::at`].
     pub fn at_surface(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Mat2 {
-        let Some(uv_mirrored) = uv_mirrored else { return self.at(uv) };
-        let mut flipped = false;
-        let mut product = Mat2::IDENTITY;
-        for f in &self.factors {
-            let mut m = bounded(f.at(uv));
-            if matches!(f, Deformation::Map(_)) && !flipped {
-                flipped = true;
-                if (m.determinant() < 0.0) != uv_mirrored {
-                    m = Mat2::from_diagonal(Vec2::new(1.0, -1.0)) * m;
-                }
-            }
-            product = bounded(product * m);
+        if uv_mirrored.is_none() {
+            return self.at(uv);
         }
-        product
+        let first_map = self.factors.iter().position(|f| matches!(f, Deformation::Map(_)));
+        self.factors.iter().enumerate().fold(Mat2::IDENTITY, |product, (k, f)| {
+            let m = bounded(f.at(uv));
+            bounded(product * if Some(k) == first_map { with_handedness(m, uv_mirrored) } else { m })
+        })
     }
 
     /// The first F map factor at `uv` (None without one), mirrored as
     /// [`DeformationField::at_surface`] does: the field whose units cut bands measure in.
     pub fn map_at(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Option<Mat2> {
         let m = bounded(self.factors.iter().find(|f| matches!(f, Deformation::Map(_)))?.at(uv));
-        let flip = uv_mirrored.is_some_and(|mirrored| (m.determinant() < 0.0) != mirrored);
-        Some(if flip { Mat2::from_diagonal(Vec2::new(1.0, -1.0)) * m } else { m })
+        Some(with_handedness(m, uv_mirrored))
     }
 
     /// The first F map factor's texels (None without one).

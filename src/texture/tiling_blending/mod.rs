@@ -189,6 +189,9 @@ impl Synthesis {
     #[inline]
     fn band_lookups(&self, ctx: &TexCtx, f: Mat2, out: &mut [TileLookup; MAX_LOOKUPS]) -> usize {
         let (Some(cuts), Some(field)) = (&self.cuts, &self.deformation) else { return 0 };
+        if !cuts.near(ctx.uv) {
+            return 0;
+        }
         let Some(f_map) = field.map_at(ctx.uv, ctx.uv_mirrored) else { return 0 };
         let bands = cuts.at(ctx.uv, f_map);
         if bands.iter().all(Option::is_none) || !(f_map.determinant().abs() > 1e-20) {
