@@ -49,5 +49,6 @@ pub mod math;
 pub mod sampling;
 pub mod scene;
 pub mod texture;
+pub mod tiles;
 
 pub use error::{Error, Result};

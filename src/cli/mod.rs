@@ -3,6 +3,7 @@
 
 mod bench;
 mod deform;
+mod tiles;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -175,6 +176,11 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Seamless tiled textures on quad meshes (paper 001): synthesise a tile image, map a mesh.
+    Tiles {
+        #[command(subcommand)]
+        command: tiles::TilesCommand,
+    },
     /// Measure ray casting (Mrays/s) and rendering (samples/s) throughput.
     Bench {
         /// Runs per figure (the median is printed; at most 1000).
@@ -219,6 +225,10 @@ pub fn run() -> Result<ExitCode> {
         }
         Command::Diff { test, reference, variance, spp, max_relmse, max_flip, output } => {
             diff(&test, &reference, variance.as_deref().zip(spp), max_relmse, max_flip, output.as_deref())
+        }
+        Command::Tiles { command } => {
+            tiles::run(command)?;
+            Ok(ExitCode::SUCCESS)
         }
         Command::Montage { images, columns, labels, output } => {
             montage(&images, columns as usize, &labels, &output)?;

@@ -10,7 +10,7 @@
 //! [`crate::texture::tiling_blending::CutBands`].
 
 use super::field::{ChartField, barycentric};
-use crate::geometry::TriangleMesh;
+use crate::geometry::{Topology, TriangleMesh};
 use crate::texture::tiling_blending::{CutCurve, CutPoint};
 use glam::Vec2;
 use std::collections::HashMap;
@@ -96,40 +96,29 @@ impl Cuts {
     pub fn new(mesh: &TriangleMesh) -> Self {
         let Some(uvs) = &mesh.uvs else { return Cuts::default() };
         let (welded, points) = mesh.welded_vertices();
-        // The UVs each face gives each welded edge (lower vertex id first), edges in order of
-        // first appearance.
-        let mut index: HashMap<(u32, u32), usize> = HashMap::new();
-        let mut keys: Vec<(u32, u32)> = Vec::new();
-        let mut faces: Vec<Vec<([Vec2; 2], u32)>> = Vec::new();
-        for (t, tri) in mesh.indices.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let (wa, wb) = (welded[a as usize], welded[b as usize]);
-                if wa == wb {
-                    continue;
-                }
-                let (key, uv) = if wa < wb {
-                    ((wa, wb), [uvs[a as usize], uvs[b as usize]])
-                } else {
-                    ((wb, wa), [uvs[b as usize], uvs[a as usize]])
-                };
-                let slot = *index.entry(key).or_insert_with(|| {
-                    keys.push(key);
-                    faces.push(Vec::new());
-                    faces.len() - 1
-                });
-                faces[slot].push((uv, t as u32));
-            }
-        }
+        let triangles: Vec<[u32; 3]> = mesh.indices.iter().map(|t| t.map(|i| welded[i as usize])).collect();
+        let topology = Topology::new(&triangles);
+        // The UVs a face gives a half-edge's endpoints, lower welded vertex first.
+        let uvs_along = |h: usize| {
+            let (t, k) = (topology.face_of(h), topology.side_of(h));
+            let tri = mesh.indices[t];
+            let (a, b) = (uvs[tri[k] as usize], uvs[tri[(k + 1) % 3] as usize]);
+            let [wa, wb] = topology.endpoints(h);
+            if wa < wb { [a, b] } else { [b, a] }
+        };
         let mut non_manifold = 0;
         let mut edges = Vec::new();
-        for ((a, b), uv) in keys.into_iter().zip(faces) {
-            match uv.as_slice() {
-                [(left, f0), (right, f1)]
-                    if left[0].distance_squared(right[0]) > 1e-12 || left[1].distance_squared(right[1]) > 1e-12 =>
-                {
-                    let length = points[a as usize].distance(points[b as usize]);
-                    edges.push(CutEdge { sides: [*left, *right], vertices: [a, b], faces: [*f0, *f1], length });
+        for e in 0..topology.edge_count() {
+            let [a, b] = topology.edge_vertices(e);
+            match topology.halves(e) {
+                _ if a == b => {}
+                &[h0, h1] => {
+                    let (left, right) = (uvs_along(h0 as usize), uvs_along(h1 as usize));
+                    if left[0].distance_squared(right[0]) > 1e-12 || left[1].distance_squared(right[1]) > 1e-12 {
+                        let length = points[a as usize].distance(points[b as usize]);
+                        let faces = [topology.face_of(h0 as usize) as u32, topology.face_of(h1 as usize) as u32];
+                        edges.push(CutEdge { sides: [left, right], vertices: [a, b], faces, length });
+                    }
                 }
                 [_, _, _, ..] => non_manifold += 1,
                 _ => {}

@@ -6,13 +6,19 @@ mod frame;
 mod interaction;
 mod mesh;
 pub mod obj;
+mod quad_mesh;
 mod ray;
 pub mod shapes;
+mod subdivision;
+mod topology;
 
 pub use frame::Frame;
 pub use interaction::{SurfaceInteraction, TriangleVertices};
 pub use mesh::{Bounds, TriangleMesh};
+pub use quad_mesh::{QuadMesh, QuadMeshReport, load_quad_obj};
 pub use ray::{Ray, RayDifferential};
+pub use subdivision::{bilinear_in_quad, catmull_clark};
+pub use topology::Topology;
 
 use glam::Vec3;
 

@@ -128,6 +128,24 @@ pub enum TextureDesc {
     },
     /// Tiling and blending of an exemplar, optionally deformed (paper 000 Sec. 3).
     TilingBlending(Box<TilingBlendingDesc>),
+    /// A tile image written by `tessera tiles synth` (paper 001), for a quad mesh whose
+    /// texture coordinates `tessera tiles map` assigned: each lookup filters one tile only.
+    QuadTiles {
+        /// The tile image.
+        filename: String,
+        /// Its number of boundary conditions (default 1: 16 tiles).
+        #[serde(default = "one_condition")]
+        conditions: u32,
+        /// Lookup filter (default `none`: bilinear at the point).
+        #[serde(default)]
+        filter: Filter,
+        /// How integer values encode colour (as for `image`).
+        colorspace: Option<ColorSpace>,
+    },
+}
+
+fn one_condition() -> u32 {
+    1
 }
 
 /// `type = "tiling_blending"`: an exemplar read through tiles, shifts, a deformation field and

@@ -22,7 +22,7 @@ use crate::material::{
 use crate::texture::tiling_blending::{
     Blend, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
 };
-use crate::texture::{ImageTexture, MipMap, Texture, TilingBlending};
+use crate::texture::{ImageTexture, MipMap, QuadTilesTexture, Texture, TilingBlending};
 use glam::{Mat2, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::f32::consts::PI;
@@ -310,7 +310,9 @@ impl<'a> Loader<'a> {
         };
         let role_space = if role == Role::Color { ColorSpace::Srgb } else { ColorSpace::Linear };
         let space = match desc {
-            TextureDesc::Image { colorspace, .. } => colorspace.unwrap_or(role_space),
+            TextureDesc::Image { colorspace, .. } | TextureDesc::QuadTiles { colorspace, .. } => {
+                colorspace.unwrap_or(role_space)
+            }
             TextureDesc::TilingBlending(_) => role_space,
         };
         let key = (name.to_string(), space);
@@ -350,6 +352,14 @@ impl<'a> Loader<'a> {
                 })
             }
             TextureDesc::TilingBlending(d) => self.tiling_blending(name, d, role)?,
+            TextureDesc::QuadTiles { filename, conditions, filter, .. } => {
+                let file = self.resolve_path(filename);
+                let bitmap =
+                    read_bitmap(&file, space).map_err(|e| e.in_scene(self.path, format!("textures.{name}")))?;
+                let tiles = QuadTilesTexture::new(&bitmap, *conditions, *filter)
+                    .map_err(|msg| self.error(format!("textures.{name}: {}: {msg}", file.display())))?;
+                Texture::QuadTiles(tiles)
+            }
         };
         self.textures_in_progress.pop();
         self.built_textures.insert(key.clone(), texture.clone());

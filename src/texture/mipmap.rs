@@ -1,6 +1,7 @@
 //! MIP pyramids and filtered lookups: bilinear at the finest level (`none`), trilinear, and
 //! elliptically weighted averaging (`ewa`), with pbrt-v4's `MIPMap` semantics.
-//! Texture coordinates wrap (repeat).
+//! Texture coordinates wrap (repeat), or clamp to the edge texels ([`MipMap::clamped`]: the
+//! tiles of paper 001, each filtered on its own).
 
 use crate::image::Bitmap;
 use crate::math::{floor, floor2};
@@ -37,6 +38,8 @@ static EWA_WEIGHTS: std::sync::LazyLock<[f32; EWA_LUT_SIZE]> = std::sync::LazyLo
 #[derive(Clone, Debug)]
 pub struct MipMap {
     levels: Vec<Bitmap>,
+    /// Lookups outside the image read its edge texels instead of wrapping.
+    clamp: bool,
 }
 
 /// Box-filter `src` to `new_len` samples along one axis (`horizontal` or vertical); each output
@@ -103,7 +106,13 @@ impl MipMap {
             let half = downsample_axis(&downsample_axis(last, w, true), h, false);
             levels.push(half);
         }
-        MipMap { levels }
+        MipMap { levels, clamp: false }
+    }
+
+    /// The pyramid of `base` whose lookups clamp to the edge texels at every level instead of
+    /// wrapping: nothing beyond the image's edge is ever read.
+    pub fn clamped(base: Bitmap) -> Self {
+        MipMap { clamp: true, ..MipMap::new(base) }
     }
 
     /// Number of levels.
@@ -125,7 +134,11 @@ impl MipMap {
     #[inline(always)]
     fn texel(&self, level: usize, x: i64, y: i64) -> Vec4 {
         let l = &self.levels[level];
-        l.pixel(wrap(x, l.width), wrap(y, l.height))
+        if self.clamp {
+            l.pixel(x.clamp(0, l.width as i64 - 1) as usize, y.clamp(0, l.height as i64 - 1) as usize)
+        } else {
+            l.pixel(wrap(x, l.width), wrap(y, l.height))
+        }
     }
 
     /// Bilinear interpolation of `level` at `st` (image coordinates in [0, 1]: x right, y down),
@@ -147,7 +160,7 @@ impl MipMap {
     /// [0, 1] image units per pixel).
     pub fn lookup(&self, filter: Filter, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
         // Wrap first so that f32 precision does not degrade far from the origin.
-        let st = st - floor2(st);
+        let st = if self.clamp { st.clamp(Vec2::ZERO, Vec2::ONE) } else { st - floor2(st) };
         match filter {
             Filter::None => self.bilinear(0, st),
             Filter::Trilinear => self.at_level(self.trilinear_lod(dst0, dst1), |level| self.bilinear(level, st)),
@@ -230,7 +243,7 @@ impl MipMap {
         // The image repeats: start from the first period, so that the ellipse's bounds below are
         // a few texels apart however far out `st` is (far out, adjacent floats are millions of
         // texels apart, and the loops would run over all of them).
-        let st = st - st.floor();
+        let st = if self.clamp { st } else { st - st.floor() };
         let c = st * res - Vec2::splat(0.5);
         let (d0, d1) = (dst0 * res, dst1 * res);
         // Implicit ellipse A x^2 + B x y + C y^2 < 1; the +1 keeps at least a texel's width.

@@ -6,10 +6,12 @@
 
 mod bake;
 mod mipmap;
+mod quad_tiles;
 pub mod tiling_blending;
 
 pub use bake::{BakeFootprint, bake};
 pub use mipmap::{Filter, MipMap};
+pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
 
 use glam::{Vec2, Vec3, Vec4};
@@ -104,6 +106,8 @@ pub enum Texture {
     Image(ImageTexture),
     /// Tiling and blending of an exemplar, optionally deformed (paper 000).
     TilingBlending(TilingBlending),
+    /// A tile image of paper 001 read tile by tile (a quad mesh mapped by `tessera tiles map`).
+    QuadTiles(QuadTilesTexture),
 }
 
 impl Texture {
@@ -113,6 +117,7 @@ impl Texture {
         match self {
             Texture::Image(t) => t.eval(ctx),
             Texture::TilingBlending(t) => t.eval(ctx),
+            Texture::QuadTiles(t) => t.eval(ctx),
         }
     }
 
@@ -140,6 +145,7 @@ impl Texture {
         match self {
             Texture::Image(t) => t.filter != Filter::None,
             Texture::TilingBlending(t) => t.uses_footprint(),
+            Texture::QuadTiles(t) => t.filter != Filter::None,
         }
     }
 
@@ -148,6 +154,7 @@ impl Texture {
         match self {
             Texture::Image(t) => t.mipmap.memory_bytes(),
             Texture::TilingBlending(t) => t.memory_bytes(),
+            Texture::QuadTiles(t) => t.memory_bytes(),
         }
     }
 }
