@@ -693,3 +693,56 @@ fn lost_data_and_empty_scenes_are_reported() {
     assert!(stacked.contains("33.33% of the UV area is covered by more than one triangle"), "{stacked}");
     assert!(!run("plain.obj").contains("overlapping"));
 }
+
+/// `tessera tiles`: a triangle in a quad-only mesh, a non-manifold edge and a 3 x 3 image are
+/// errors naming the file and the problem; a good output file stays as it was; a scene whose
+/// `quad_tiles` image has the wrong size is an error naming the texture.
+#[test]
+fn bad_tile_inputs_are_named_and_keep_existing_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name);
+    let quads = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nv 3 3 3\nv 4 4 4\n";
+    std::fs::write(path("triangle.obj"), format!("{quads}f 1 2 3 4\nf 2 5 6\n")).unwrap();
+    std::fs::write(path("fan.obj"), format!("{quads}f 1 2 3 4\nf 2 5 6 3\nf 3 7 8 2\n")).unwrap();
+    std::fs::write(path("tiny.png"), png(image::RgbImage::new(3, 3))).unwrap();
+    std::fs::write(path("good.obj"), b"a good mesh").unwrap();
+    std::fs::write(path("good.png"), b"a good image").unwrap();
+    let run = |args: &[&std::ffi::OsStr]| {
+        let out = tessera().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(stderr.starts_with("error: ") && !stderr.contains("panicked"), "{stderr}");
+        stderr
+    };
+    let os = |s: &str| std::ffi::OsString::from(s);
+    let map =
+        |mesh: &str| run(&[&os("tiles"), &os("map"), path(mesh).as_os_str(), &os("-o"), path("good.obj").as_os_str()]);
+    let msg = map("triangle.obj");
+    assert!(msg.contains("triangle.obj") && msg.contains("face 2 (line 10) has 3 corners"), "{msg}");
+    let msg = map("fan.obj");
+    assert!(msg.contains("fan.obj") && msg.contains("non-manifold") && msg.contains("vertices 2 and 3"), "{msg}");
+    let msg = run(&[&os("tiles"), &os("synth"), path("tiny.png").as_os_str(), &os("-o"), path("good.png").as_os_str()]);
+    assert!(msg.contains("tiny.png") && msg.contains("too small"), "{msg}");
+    let msg = run(&[
+        &os("tiles"),
+        &os("synth"),
+        path("tiny.png").as_os_str(),
+        &os("--tile-res"),
+        &os("100"),
+        &os("-o"),
+        path("good.png").as_os_str(),
+    ]);
+    assert!(msg.contains("--tile-res") && msg.contains("multiple of 16"), "{msg}");
+    assert_eq!(std::fs::read(path("good.obj")).unwrap(), b"a good mesh");
+    assert_eq!(std::fs::read(path("good.png")).unwrap(), b"a good image");
+
+    let toml = format!(
+        "{CAMERA}[textures.t]\ntype = \"quad_tiles\"\nfilename = \"tiles.png\"\n[materials.m]\ntype = \"diffuse\"\n\
+         reflectance = \"t\"\n[[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\n"
+    );
+    error_of(
+        &toml,
+        &[("tiles.png", &png(image::RgbImage::new(100, 100)))],
+        &["textures.t", "tiles.png", "not a tile image"],
+    );
+}

@@ -1,6 +1,7 @@
 //! Seeded mutation fuzzing of everything that reads a file: scene loading (the shipped scenes),
 //! OBJ, glTF and GLB meshes, PNG, JPEG, Radiance HDR and OpenEXR images, `tessera deform`'s
-//! mesh reading and maps, then a tiny render (every AOV and the variance) and a bake of each
+//! mesh reading and maps, `tessera tiles map`'s quad meshes (mapping, subdivision, the OBJ it
+//! writes, a `quad_tiles` texture on it), then a tiny render (every AOV and the variance) and a bake of each
 //! texture of what loaded. The properties checked, for every case:
 //! - no panic (a panic inside a third-party parser that tessera catches is an error, which is
 //!   fine; one that escapes fails the case),
@@ -44,8 +45,8 @@ static LIVE: AtomicUsize = AtomicUsize::new(0);
 static CURRENT_CASE: AtomicUsize = AtomicUsize::new(usize::MAX);
 /// Per kind of seed: cases run, and cases whose mutated input still loaded as a scene and was
 /// rendered (the fuzzer's depth).
-static CASES: [AtomicUsize; 6] = [const { AtomicUsize::new(0) }; 6];
-static RENDERED: [AtomicUsize; 6] = [const { AtomicUsize::new(0) }; 6];
+static CASES: [AtomicUsize; 7] = [const { AtomicUsize::new(0) }; 7];
+static RENDERED: [AtomicUsize; 7] = [const { AtomicUsize::new(0) }; 7];
 
 #[global_allocator]
 static ALLOCATOR: BudgetAllocator = BudgetAllocator;
@@ -364,6 +365,9 @@ enum Kind {
     /// A cuts file of `tessera deform`, read by a tiling-and-blending texture with the lat-long
     /// sphere's F map.
     Cuts,
+    /// A quad mesh for `tessera tiles map`: mapped, subdivided, written, and rendered with a
+    /// `quad_tiles` texture.
+    QuadObj,
 }
 
 /// An input to mutate.
@@ -427,6 +431,12 @@ fn seeds() -> Vec<Seed> {
     tessera::image::write_exr(&exr, 6, 5, planes.into()).unwrap();
     seeds.push(file(Kind::Image, "small.exr", std::fs::read(&exr).unwrap()));
     seeds.push(file(Kind::Cuts, "cuts.json", std::fs::read(root.join("scenes/maps/smiley/cuts.json")).unwrap()));
+    seeds.push(file(Kind::QuadObj, "cube.obj", std::fs::read(root.join("scenes/meshes/cube_quads.obj")).unwrap()));
+    seeds.push(file(
+        Kind::QuadObj,
+        "strip.obj",
+        b"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\ng a\nf 1 2 5 4\ng b\nf 2 3 6 5\n".to_vec(),
+    ));
     seeds
 }
 
@@ -449,6 +459,13 @@ fn scene_using(kind: Kind, file: &str) -> String {
                 [camera]\nfov = 50\neye = [0.5, 0.5, 3]\ntarget = [0.5, 0.5, 0]\n";
     match kind {
         Kind::Obj => format!("{head}[[shapes]]\ntype = \"obj\"\nfilename = \"{file}\"\nemission = 1\n"),
+        Kind::QuadObj => format!(
+            "{head}[textures.t]\ntype = \"quad_tiles\"\nfilename = \"{}\"\nfilter = \"ewa\"\n\
+             [materials.m]\ntype = \"diffuse\"\nreflectance = \"t\"\n\
+             [[shapes]]\ntype = \"obj\"\nfilename = \"mapped.obj\"\nmaterial = \"m\"\n\
+             [environment]\ntype = \"constant\"\nradiance = 1\n",
+            common::repo().join("scenes/quad_tiles/rock2_tiles.png").display()
+        ),
         Kind::Cuts => {
             let root = common::repo().join("scenes");
             let (f_map, mesh) = (root.join("maps/smiley/f_map.exr"), root.join("meshes/smiley.obj"));
@@ -512,7 +529,7 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     let bytes = match seed.kind {
         Kind::Glb => mutate_glb(rng, &seed.bytes),
         Kind::Gltf | Kind::Cuts => mutate_json(rng, &String::from_utf8_lossy(&seed.bytes)),
-        Kind::Scene | Kind::Obj => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
+        Kind::Scene | Kind::Obj | Kind::QuadObj => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
         Kind::Image => {
             let mut b = seed.bytes.clone();
             mutate_bytes(rng, &mut b);
@@ -532,6 +549,23 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
         if let Ok((mesh, _)) = load_surface(&file) {
             if mesh.uvs.is_some() {
                 let _ = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 32, 0.25);
+            }
+        }
+    } else if seed.kind == Kind::QuadObj {
+        let _ = std::fs::remove_file(dir.join("mapped.obj"));
+        if let Ok(mut mesh) = tessera::geometry::load_quad_obj(&file) {
+            if let Ok((topology, _)) = mesh.topology() {
+                let layout = tessera::tiles::TileLayout::new(1, 16).unwrap();
+                let types = tessera::tiles::assign_boundaries(&topology, 1, 0);
+                mesh.uvs = Some(tessera::tiles::texture_coordinates(
+                    &layout,
+                    &tessera::tiles::assign_tiles(&topology, &types),
+                ));
+                if mesh.quads.len() < 10_000 {
+                    mesh = tessera::geometry::catmull_clark(&mesh, &topology);
+                }
+                mesh.write_obj(&dir.join("mapped.obj"), "tiles.png", Some(&mesh.vertex_normals()))
+                    .map_err(|e| format!("writing the mapped mesh: {e}"))?;
             }
         }
     } else if seed.kind == Kind::Cuts {
@@ -600,7 +634,7 @@ fn fuzz_loaders_with_mutated_inputs() {
         }
     }
     worker.join().unwrap();
-    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image", "cuts"]
+    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image", "cuts", "quad OBJ"]
         .iter()
         .enumerate()
         .map(|(k, name)| format!("{name} {}/{}", RENDERED[k].load(Ordering::Relaxed), CASES[k].load(Ordering::Relaxed)))

@@ -22,7 +22,7 @@ fn photograph() -> Bitmap {
 fn tile_image(conditions: u32, res: u32, seed: u64) -> (Bitmap, TileLayout) {
     let image = photograph();
     let layout = TileLayout::new(conditions, res).unwrap();
-    let templates = TileTemplates::new(image.width, image.height, conditions, &[], None).unwrap();
+    let templates = TileTemplates::new(&image, conditions, &[], None).unwrap();
     (synthesize_tiles(&image, &templates, &layout, seed), layout)
 }
 
@@ -188,8 +188,7 @@ fn tile_1001_worked_by_hand() {
         }
     }
     let templates = TileTemplates::new(
-        w,
-        h,
+        &image,
         1,
         &[PixelRect { x: 0, y: 0, width: 64, height: 128 }],
         Some(PixelRect { x: 64, y: 0, width: 64, height: 128 }),
@@ -220,15 +219,69 @@ fn tile_1001_worked_by_hand() {
 
 #[test]
 fn bad_tile_inputs_are_clear_errors() {
-    let tiny = TileTemplates::new(3, 3, 1, &[], None).unwrap_err();
+    let tiny = TileTemplates::new(&Bitmap::new(3, 3, 3), 1, &[], None).unwrap_err();
     assert!(tiny.contains("too small"), "{tiny}");
-    let not_stacked = TileTemplates::new(256, 256, 1, &[PixelRect { x: 0, y: 0, width: 64, height: 64 }], None);
+    let not_stacked =
+        TileTemplates::new(&Bitmap::new(256, 256, 3), 1, &[PixelRect { x: 0, y: 0, width: 64, height: 64 }], None);
     assert!(not_stacked.unwrap_err().contains("two stacked squares"));
-    let outside = TileTemplates::new(256, 256, 1, &[PixelRect { x: 200, y: 0, width: 64, height: 128 }], None);
+    let outside =
+        TileTemplates::new(&Bitmap::new(256, 256, 3), 1, &[PixelRect { x: 200, y: 0, width: 64, height: 128 }], None);
     assert!(outside.unwrap_err().contains("outside"));
     let wrong_size = QuadTilesTexture::new(&Bitmap::new(100, 100, 3), 1, Filter::None).unwrap_err();
     assert!(wrong_size.contains("not a tile image"), "{wrong_size}");
     // Bilinear in a quad is what subdivision carries.
     let corners = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
     assert_eq!(bilinear_in_quad(&corners, 0.5, 0.5), Vec2::splat(0.5));
+}
+
+/// No filter mixes tiles: a tile image whose every tile (guard band included) is one flat
+/// colour, read with footprints from a fraction of a texel to wider than the whole image, gives
+/// each tile's own colour at every point of it, near its edges and corners too. A plain image
+/// texture of the same file does mix them at coarse levels (the control).
+#[test]
+fn filtered_lookups_never_mix_tiles_at_any_mip_level() {
+    let layout = TileLayout::new(1, 32).unwrap();
+    let side = layout.image_side();
+    let mut atlas = Bitmap::new(side, side, 3);
+    let colour = |name: TileName| {
+        let i = layout.index_of(name) as f32;
+        Vec3::new(i / 15.0, 1.0 - i / 15.0, (i * 7.0 % 16.0) / 15.0)
+    };
+    for name in layout.names() {
+        let g = layout.guard() as isize;
+        for j in -g..32 + g {
+            for i in -g..32 + g {
+                let (x, y) = layout.texel(name, i, j);
+                atlas.values_mut(x, y).copy_from_slice(&colour(name).to_array());
+            }
+        }
+    }
+    let whole = MipMap::new(atlas.clone());
+    let mut control_mixes = false;
+    for filter in [Filter::Trilinear, Filter::Ewa] {
+        let texture = QuadTilesTexture::new(&atlas, 1, filter).unwrap();
+        for name in layout.names() {
+            for (s, t) in [(0.0, 0.0), (0.5, 0.5), (1.0, 0.3), (0.02, 0.98), (1.0, 1.0)] {
+                let c = layout.corner_uv(name, 0);
+                let uv = c + (layout.corner_uv(name, 2) - c) * Vec2::new(s, t);
+                for width in [1e-4, 1e-2, 0.1, 1.0, 10.0] {
+                    let ctx = TexCtx {
+                        uv,
+                        duv_dx: Vec2::new(width, 0.0),
+                        duv_dy: Vec2::new(0.0, width * 0.3),
+                        ..Default::default()
+                    };
+                    let v = texture.eval(&ctx).truncate();
+                    assert!(
+                        v.abs_diff_eq(colour(name), 1e-5),
+                        "{filter:?} tile {name} at ({s}, {t}), width {width}: {v}"
+                    );
+                    let st = Vec2::new(uv.x, 1.0 - uv.y);
+                    let plain = whole.lookup(filter, st, ctx.duv_dx, -ctx.duv_dy).truncate();
+                    control_mixes |= !plain.abs_diff_eq(colour(name), 1e-3);
+                }
+            }
+        }
+    }
+    assert!(control_mixes, "a pyramid of the whole image should mix tiles at coarse levels");
 }

@@ -14,6 +14,11 @@
 //!   tiling and blending, and deformed tiling and blending with a 256 x 256 F map, for the
 //!   linear and Mix-Max operators; printed as lookups per second and as cost ratios to the bitmap
 //!   measured in the same run.
+//! - Paper 001's tiles: `tessera tiles map`'s mapping (edge adjacency, AssignBoundaries,
+//!   AssignTextureCoordinates) of a generated torus of 1M quads on one thread, with the peak
+//!   memory it adds (Linux), against pairing the same edges through a hash map; and the
+//!   synthesis of a 4 x 4 tile image of 256-texel tiles from `scenes/textures/rocks_basecolor.jpg`,
+//!   against resampling as many texels bilinearly.
 
 use glam::{Mat2, Vec2};
 use rayon::prelude::*;
@@ -74,6 +79,8 @@ pub enum Suite {
     Textures,
     /// `tessera deform` on a mesh of 262k triangles.
     Deform,
+    /// Paper 001: mapping 1M quads, synthesising 16 tiles of 256 texels.
+    Tiles,
 }
 
 /// Run the benchmarks of `suites` and print a table. `scene_dir` holds the shipped scenes.
@@ -95,6 +102,9 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> R
     }
     if suites.contains(&Suite::Deform) {
         deform(runs)?;
+    }
+    if suites.contains(&Suite::Tiles) {
+        tiles(scene_dir, runs, &pool)?;
     }
     Ok(())
 }
@@ -308,6 +318,96 @@ fn deform(runs: usize) -> Result<()> {
     println!(
         "deform     UV sphere of {} triangles, 1 round of smoothing, F map 1024x1024, cut bands: {seconds:.3} s on 1 thread (target < 1 s)",
         mesh.indices.len()
+    );
+    Ok(())
+}
+
+/// Resident memory figures of this process from /proc/self/status, in bytes (Linux only).
+fn resident_bytes(field: &str) -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with(field))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Run `f` and return what it returns and the most resident memory it added (Linux: the peak
+/// is reset through /proc/self/clear_refs first; None elsewhere).
+fn with_peak_memory<T>(f: impl FnOnce() -> T) -> (T, Option<u64>) {
+    let reset = std::fs::write("/proc/self/clear_refs", "5").is_ok();
+    let before = resident_bytes("VmRSS:");
+    let out = f();
+    let peak = resident_bytes("VmHWM:");
+    (out, before.zip(peak).filter(|_| reset).map(|(b, p)| p.saturating_sub(b)))
+}
+
+/// A torus of `m` x `n` quads (every vertex of valence 4, every edge shared by two quads).
+fn torus_quads(m: u32, n: u32) -> Vec<[u32; 4]> {
+    let id = |i: u32, j: u32| (j % n) * m + (i % m);
+    (0..n).flat_map(|j| (0..m).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])).collect()
+}
+
+fn tiles(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
+    use tessera::geometry::Topology;
+    use tessera::tiles::{TileLayout, TileTemplates, assign_boundaries, assign_tiles, texture_coordinates};
+    let quads = torus_quads(1000, 1000);
+    let layout = TileLayout::new(1, 256).expect("a valid layout");
+    let (mut times, mut baseline, mut peak) = (Vec::new(), Vec::new(), 0u64);
+    for run in 0..runs {
+        let start = Instant::now();
+        let (uvs, added) = with_peak_memory(|| {
+            let topology = Topology::new(&quads);
+            let tiles = assign_tiles(&topology, &assign_boundaries(&topology, 1, run as u64));
+            texture_coordinates(&layout, &tiles)
+        });
+        times.push(start.elapsed().as_secs_f64());
+        peak = peak.max(added.unwrap_or(0));
+        std::hint::black_box(uvs.len());
+        let start = Instant::now();
+        let mut pairs: std::collections::HashMap<(u32, u32), [u32; 2]> = std::collections::HashMap::new();
+        for (f, q) in quads.iter().enumerate() {
+            for k in 0..4 {
+                let (a, b) = (q[k], q[(k + 1) % 4]);
+                pairs.entry((a.min(b), a.max(b))).or_insert([u32::MAX; 2])[usize::from(a > b)] = f as u32;
+            }
+        }
+        std::hint::black_box(pairs.len());
+        baseline.push(start.elapsed().as_secs_f64());
+    }
+    let (seconds, hashing) = (median(times), median(baseline));
+    let memory = if peak > 0 { format!("{:.0} MB peak added", peak as f64 / 1e6) } else { "peak memory n/a".into() };
+    println!(
+        "tiles map  torus of {} quads, 1 thread: {seconds:.3} s, {memory} (targets < 0.5 s, < 300 MB); {:.2}x the time of \
+         pairing its edges through a hash map ({hashing:.3} s)",
+        quads.len(),
+        seconds / hashing
+    );
+
+    let image = read_bitmap(&scene_dir.join("textures/rocks_basecolor.jpg"), ColorSpace::Srgb)?;
+    let templates = TileTemplates::new(&image, 1, &[], None).map_err(|m| Error::param("bench", m))?;
+    let mipmap = MipMap::new(image.clone());
+    let texels = layout.tile_count() * layout.tile_res() * layout.tile_res();
+    let (mut times, mut baseline) = (Vec::new(), Vec::new());
+    for run in 0..runs {
+        let start = Instant::now();
+        let atlas = pool.install(|| tessera::tiles::synthesize_tiles(&image, &templates, &layout, run as u64));
+        times.push(start.elapsed().as_secs_f64());
+        std::hint::black_box(atlas.data.len());
+        let start = Instant::now();
+        let sum: f32 = pool.install(|| {
+            (0..texels)
+                .into_par_iter()
+                .map(|t| mipmap.bilinear(0, Vec2::new((t % 4096) as f32 / 4096.0, (t / 4096) as f32 / 256.0)).x)
+                .sum()
+        });
+        std::hint::black_box(sum);
+        baseline.push(start.elapsed().as_secs_f64());
+    }
+    let (seconds, resampling) = (median(times), median(baseline));
+    println!(
+        "tiles synth 16 tiles of 256 texels, {} threads: {seconds:.3} s, {:.1}x the time of resampling as many texels \
+         bilinearly ({resampling:.4} s)",
+        pool.current_num_threads(),
+        seconds / resampling
     );
     Ok(())
 }

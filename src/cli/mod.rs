@@ -194,7 +194,7 @@ enum Command {
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
         /// Which figures to measure, comma separated (default: all).
-        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures", "deform"])]
+        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures", "deform", "tiles"])]
         only: Vec<bench::Suite>,
     },
 }

@@ -103,8 +103,8 @@ fn synth(
     }
     let layout = TileLayout::new(conditions, tile_res).map_err(|msg| Error::param("--tile-res", msg))?;
     let image = read_bitmap(image_path, ColorSpace::Srgb)?;
-    let templates = TileTemplates::new(image.width, image.height, conditions, boundaries, background)
-        .map_err(|msg| Error::image(image_path, msg))?;
+    let templates =
+        TileTemplates::new(&image, conditions, boundaries, background).map_err(|msg| Error::image(image_path, msg))?;
     let start = Instant::now();
     let bar = spinner(format!("synthesising {} tiles of {tile_res} texels", layout.tile_count()));
     let atlas = tessera::tiles::synthesize_tiles(&image, &templates, &layout, seed);

@@ -79,19 +79,19 @@ pub struct TileTemplates {
 }
 
 impl TileTemplates {
-    /// Templates for an image of `width` x `height` with `conditions` conditions, defaults where
-    /// `boundaries` gives fewer than `conditions` or `background` is None: squares of half the
-    /// largest that fits twice vertically, the boundary templates spread along the image's
-    /// middle, the background the whole image. Checks that every rectangle fits the image, that
-    /// each boundary template is two squares of the same side, and the background holds one.
+    /// Templates for `image` with `conditions` conditions, defaults where `boundaries` gives
+    /// fewer than `conditions` or `background` is None: squares of half the largest that fits
+    /// twice vertically; boundary templates where the photograph is most typical
+    /// ([`typical_rectangles`]); the background the whole image. Checks that every rectangle
+    /// fits the image, that each boundary template is two squares of the same side, and that
+    /// the background holds one.
     pub fn new(
-        width: usize,
-        height: usize,
+        image: &Bitmap,
         conditions: u32,
         boundaries: &[PixelRect],
         background: Option<PixelRect>,
     ) -> Result<Self, String> {
-        let (w, h) = (width as u32, height as u32);
+        let (w, h) = (image.width as u32, image.height as u32);
         if boundaries.len() > conditions as usize {
             return Err(format!("{} boundary templates for {conditions} condition(s)", boundaries.len()));
         }
@@ -106,15 +106,11 @@ impl TileTemplates {
             ));
         }
         let mut all = boundaries.to_vec();
-        for k in all.len()..conditions as usize {
-            // Spread along the middle row of the image: k-th of n evenly spaced columns.
-            let n = conditions as u64;
-            let centre = ((2 * k as u64 + 1) * w as u64 / (2 * n)) as u32;
-            let x = centre.saturating_sub(side / 2).min(w.saturating_sub(side));
-            all.push(PixelRect { x, y: (h / 2).saturating_sub(side), width: side, height: 2 * side });
+        if all.len() < conditions as usize && side <= w.min(h / 2) {
+            let missing = conditions as usize - all.len();
+            all.extend(typical_rectangles(image, side, missing, &all));
         }
         let background = background.unwrap_or(PixelRect { x: 0, y: 0, width: w, height: h });
-        let image = Bitmap { width, height, channels: 1, data: Vec::new() };
         for (k, b) in all.iter().enumerate() {
             if b.width != side || b.height != 2 * side {
                 return Err(format!(
@@ -123,11 +119,11 @@ impl TileTemplates {
                     2 * side
                 ));
             }
-            if !b.fits_in(&image) {
+            if !b.fits_in(image) {
                 return Err(format!("boundary template {} ({b}) reaches outside the {w} x {h} image", k + 1));
             }
         }
-        if !background.fits_in(&image) {
+        if !background.fits_in(image) {
             return Err(format!("background region {background} reaches outside the {w} x {h} image"));
         }
         if background.width < side || background.height < side {
@@ -140,6 +136,48 @@ impl TileTemplates {
     pub fn side(&self) -> u32 {
         self.boundaries[0].width
     }
+}
+
+/// `count` boundary templates (two stacked squares of `side` pixels) where the photograph is
+/// most typical: of a 9 x 9 grid of positions, those whose rectangle's mean colour and spread
+/// are nearest the whole image's (so that the boundary, which every tile edge shows, crosses no
+/// rare feature), preferring positions that overlap neither `taken` nor each other.
+fn typical_rectangles(image: &Bitmap, side: u32, count: usize, taken: &[PixelRect]) -> Vec<PixelRect> {
+    let statistics = |x0: f32, y0: f32, w: f32, h: f32| {
+        let n = 16;
+        let values: Vec<Vec3> = (0..n * n)
+            .map(|k| {
+                sample(image, x0 + ((k % n) as f32 + 0.5) * w / n as f32, y0 + ((k / n) as f32 + 0.5) * h / n as f32)
+            })
+            .collect();
+        let mean = values.iter().sum::<Vec3>() / values.len() as f32;
+        let spread = (values.iter().map(|v| v.distance_squared(mean)).sum::<f32>() / values.len() as f32).sqrt();
+        (mean, spread)
+    };
+    let (mean, spread) = statistics(0.0, 0.0, image.width as f32, image.height as f32);
+    let room = (image.width as u32 - side, image.height as u32 - 2 * side);
+    let mut candidates: Vec<(f32, PixelRect)> = (0..81)
+        .map(|k| {
+            let rect = PixelRect { x: room.0 * (k % 9) / 8, y: room.1 * (k / 9) / 8, width: side, height: 2 * side };
+            let (m, s) = statistics(rect.x as f32, rect.y as f32, side as f32, 2.0 * side as f32);
+            (m.distance(mean) + (s - spread).abs(), rect)
+        })
+        .collect();
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let overlaps = |a: &PixelRect, b: &PixelRect| {
+        a.x < b.x + b.width && b.x < a.x + a.width && a.y < b.y + b.height && b.y < a.y + a.height
+    };
+    let mut chosen: Vec<PixelRect> = Vec::new();
+    for (_, rect) in &candidates {
+        if chosen.len() < count && !taken.iter().chain(&chosen).any(|t| overlaps(t, rect)) {
+            chosen.push(*rect);
+        }
+    }
+    // Where the image has no room for separate templates, they overlap.
+    for (_, rect) in candidates.iter().cycle().take(count - chosen.len()) {
+        chosen.push(*rect);
+    }
+    chosen
 }
 
 /// Bilinear lookup of `image` at continuous pixel coordinates (texel centres at + 0.5), clamped
