@@ -6,7 +6,7 @@
 mod common;
 
 use glam::{Vec2, Vec3, Vec4};
-use tessera::geometry::{QuadMesh, Topology, bilinear_in_quad, catmull_clark, load_quad_obj};
+use tessera::geometry::{QuadMesh, Topology, catmull_clark, load_quad_obj};
 use tessera::image::{Bitmap, ColorSpace, read_bitmap, write_png};
 use tessera::texture::{Filter, MipMap, QuadTilesTexture, TexCtx};
 use tessera::tiles::synthesis::rotate_texel;
@@ -229,9 +229,6 @@ fn bad_tile_inputs_are_clear_errors() {
     assert!(outside.unwrap_err().contains("outside"));
     let wrong_size = QuadTilesTexture::new(&Bitmap::new(100, 100, 3), 1, Filter::None).unwrap_err();
     assert!(wrong_size.contains("not a tile image"), "{wrong_size}");
-    // Bilinear in a quad is what subdivision carries.
-    let corners = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
-    assert_eq!(bilinear_in_quad(&corners, 0.5, 0.5), Vec2::splat(0.5));
 }
 
 /// No filter mixes tiles: a tile image whose every tile (guard band included) is one flat

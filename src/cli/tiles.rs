@@ -146,6 +146,9 @@ fn map(path: &Path, conditions: u32, seed: u64, subdivide: u32, texture: &str, o
     if output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("obj") {
         return Err(Error::param("--output", format!("{}: the mapped mesh is written as .obj", output.display())));
     }
+    if texture.is_empty() || texture.chars().any(char::is_control) {
+        return Err(Error::param("--texture", "give the tile image's file name (no control characters)"));
+    }
     let start = Instant::now();
     let bar = spinner(format!("reading {}", path.display()));
     let mut mesh = load_quad_obj(path)?;

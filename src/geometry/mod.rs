@@ -17,7 +17,7 @@ pub use interaction::{SurfaceInteraction, TriangleVertices};
 pub use mesh::{Bounds, TriangleMesh};
 pub use quad_mesh::{QuadMesh, QuadMeshReport, load_quad_obj};
 pub use ray::{Ray, RayDifferential};
-pub use subdivision::{bilinear_in_quad, catmull_clark};
+pub use subdivision::catmull_clark;
 pub use topology::Topology;
 
 use glam::Vec3;

@@ -11,7 +11,7 @@
 //! (P_prev + 6 P + P_next) / 8 along a boundary (a cubic B-spline crease).
 
 use super::{QuadMesh, Topology};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// One round of Catmull-Clark subdivision of `mesh`, whose `topology` is given (manifold, as
 /// [`QuadMesh::topology`] checks). New vertices: the old vertices' points, then one per edge,
@@ -100,17 +100,10 @@ pub fn catmull_clark(mesh: &QuadMesh, topology: &Topology) -> QuadMesh {
     QuadMesh { positions, quads, uvs, lines: Vec::new() }
 }
 
-/// Bilinear interpolation of a quad's corner values at (s, t) in [0, 1]^2, corner 0 at (0, 0)
-/// and the corners counter-clockwise.
-pub fn bilinear_in_quad(corners: &[Vec2; 4], s: f32, t: f32) -> Vec2 {
-    let bottom = corners[0].lerp(corners[1], s);
-    let top = corners[3].lerp(corners[2], s);
-    bottom.lerp(top, t)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec2;
 
     /// The cube, valence 3 everywhere, outward-facing quads.
     pub(crate) fn cube() -> QuadMesh {
@@ -160,7 +153,6 @@ mod tests {
         // previous edge's midpoint.
         assert_eq!(uvs[0], [Vec2::ZERO, Vec2::new(0.5, 0.0), Vec2::splat(0.5), Vec2::new(0.0, 0.5)]);
         assert_eq!(uvs[2][0], Vec2::ONE);
-        assert_eq!(bilinear_in_quad(&corners, 0.25, 0.75), Vec2::new(0.25, 0.75));
     }
 
     #[test]
