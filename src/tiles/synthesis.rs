@@ -143,23 +143,12 @@ impl TileTemplates {
 /// are nearest the whole image's (so that the boundary, which every tile edge shows, crosses no
 /// rare feature), preferring positions that overlap neither `taken` nor each other.
 fn typical_rectangles(image: &Bitmap, side: u32, count: usize, taken: &[PixelRect]) -> Vec<PixelRect> {
-    let statistics = |x0: f32, y0: f32, w: f32, h: f32| {
-        let n = 16;
-        let values: Vec<Vec3> = (0..n * n)
-            .map(|k| {
-                sample(image, x0 + ((k % n) as f32 + 0.5) * w / n as f32, y0 + ((k / n) as f32 + 0.5) * h / n as f32)
-            })
-            .collect();
-        let mean = values.iter().sum::<Vec3>() / values.len() as f32;
-        let spread = (values.iter().map(|v| v.distance_squared(mean)).sum::<f32>() / values.len() as f32).sqrt();
-        (mean, spread)
-    };
-    let (mean, spread) = statistics(0.0, 0.0, image.width as f32, image.height as f32);
+    let (mean, spread) = statistics(image, 0.0, 0.0, image.width as f32, image.height as f32);
     let room = (image.width as u32 - side, image.height as u32 - 2 * side);
     let mut candidates: Vec<(f32, PixelRect)> = (0..81)
         .map(|k| {
             let rect = PixelRect { x: room.0 * (k % 9) / 8, y: room.1 * (k / 9) / 8, width: side, height: 2 * side };
-            let (m, s) = statistics(rect.x as f32, rect.y as f32, side as f32, 2.0 * side as f32);
+            let (m, s) = statistics(image, rect.x as f32, rect.y as f32, side as f32, 2.0 * side as f32);
             (m.distance(mean) + (s - spread).abs(), rect)
         })
         .collect();
@@ -193,21 +182,25 @@ fn sample(image: &Bitmap, x: f32, y: f32) -> Vec3 {
     (p(xa, ya) * (1.0 - tx) + p(xb, ya) * tx) * (1.0 - ty) + (p(xa, yb) * (1.0 - tx) + p(xb, yb) * tx) * ty
 }
 
+/// Mean colour and RMS spread about it of the rectangle (x0, y0, w, h) of `image` (pixels),
+/// from 16 x 16 samples.
+fn statistics(image: &Bitmap, x0: f32, y0: f32, w: f32, h: f32) -> (Vec3, f32) {
+    let n = 16;
+    let values: Vec<Vec3> = (0..n * n)
+        .map(|k| sample(image, x0 + ((k % n) as f32 + 0.5) * w / n as f32, y0 + ((k / n) as f32 + 0.5) * h / n as f32))
+        .collect();
+    let mean = values.iter().sum::<Vec3>() / values.len() as f32;
+    let spread = (values.iter().map(|v| v.distance_squared(mean)).sum::<f32>() / values.len() as f32).sqrt();
+    (mean, spread)
+}
+
 /// The point of `region` (pixels) from which the corner patch, `extent` pixels wide, is read:
-/// of an 8 x 8 grid of candidates, the one whose patch's mean colour is nearest the region's.
+/// of an 8 x 8 grid of candidates, the one whose patch has the mean colour nearest the region's
+/// and little structure (its spread counts half as much), so that the patch, repeated at every
+/// vertex, draws no motif.
 fn corner_source(image: &Bitmap, region: PixelRect, extent: f32) -> (f32, f32) {
-    let mean_over = |x0: f32, y0: f32, w: f32, h: f32| {
-        let n = 8;
-        let mut sum = Vec3::ZERO;
-        for b in 0..n {
-            for a in 0..n {
-                sum += sample(image, x0 + (a as f32 + 0.5) * w / n as f32, y0 + (b as f32 + 0.5) * h / n as f32);
-            }
-        }
-        sum / (n * n) as f32
-    };
     let (x, y, w, h) = (region.x as f32, region.y as f32, region.width as f32, region.height as f32);
-    let target = mean_over(x, y, w, h);
+    let (target, _) = statistics(image, x, y, w, h);
     let room = ((w - extent).max(0.0), (h - extent).max(0.0));
     let candidates = (0..64).map(|k| {
         let (cx, cy) = (x + room.0 * ((k % 8) as f32 + 0.5) / 8.0, y + extent + room.1 * ((k / 8) as f32 + 0.5) / 8.0);
@@ -215,7 +208,10 @@ fn corner_source(image: &Bitmap, region: PixelRect, extent: f32) -> (f32, f32) {
     });
     candidates
         .min_by(|a, b| {
-            let d = |&(cx, cy): &(f32, f32)| mean_over(cx, cy - extent, extent, extent).distance(target);
+            let d = |&(cx, cy): &(f32, f32)| {
+                let (mean, spread) = statistics(image, cx, cy - extent, extent, extent);
+                mean.distance(target) + 0.5 * spread
+            };
             d(a).total_cmp(&d(b))
         })
         .expect("64 candidates")
@@ -232,16 +228,16 @@ mod shape {
     /// Width of f1 and f2's fade across the tile's diagonals on the edge; it widens by
     /// SIDE_FADE_GROWTH per unit of distance from the edge, so that the layers' borders are
     /// soft inside the tile and sharp only where the corner patch covers them.
-    pub const SIDE_FADE: f32 = 0.04;
+    pub const SIDE_FADE: f32 = 0.025;
     pub const SIDE_FADE_GROWTH: f32 = 0.8;
     /// f3 fades the layer out between these distances from its edge.
-    pub const FAR_START: f32 = 0.25;
-    pub const FAR_END: f32 = 0.45;
+    pub const FAR_START: f32 = 0.1;
+    pub const FAR_END: f32 = 0.3;
     /// The corner patch is opaque up to this distance from the corner and gone at the next.
     /// It must cover where f1 and f2 fade along the edge: SIDE_FADE plus half a texel of a
     /// 16-texel tile stays under CORNER_OPAQUE.
-    pub const CORNER_OPAQUE: f32 = 0.06;
-    pub const CORNER_END: f32 = 0.12;
+    pub const CORNER_OPAQUE: f32 = 0.045;
+    pub const CORNER_END: f32 = 0.09;
     /// f4 looks for similar colours from this distance on...
     pub const SIMILAR_FROM: f32 = 0.04;
     /// ... and fades the layer out over this distance after the first similar texel.
