@@ -46,6 +46,7 @@ pub mod light;
 pub mod limits;
 pub mod material;
 pub mod math;
+pub mod pups;
 pub mod sampling;
 pub mod scene;
 pub mod texture;

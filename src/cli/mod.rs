@@ -3,6 +3,7 @@
 
 mod bench;
 mod deform;
+mod pups;
 mod tiles;
 
 use clap::{Parser, Subcommand};
@@ -176,6 +177,8 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Bake a partition-of-unity parametric texture (paper 002) from a named preset.
+    Pups(pups::PupsArgs),
     /// Seamless tiled textures on quad meshes (paper 001): synthesise a tile image, map a mesh.
     Tiles {
         #[command(subcommand)]
@@ -226,6 +229,10 @@ pub fn run() -> Result<ExitCode> {
         Command::Diff { test, reference, variance, spp, max_relmse, max_flip, output } => {
             diff(&test, &reference, variance.as_deref().zip(spp), max_relmse, max_flip, output.as_deref())
         }
+        Command::Pups(args) => {
+            pups::run(args)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Tiles { command } => {
             tiles::run(command)?;
             Ok(ExitCode::SUCCESS)
@@ -266,12 +273,7 @@ pub fn run() -> Result<ExitCode> {
             };
             let start = Instant::now();
             let image = bake(&tex, res as usize, footprint);
-            let rgb = Bitmap {
-                width: image.width,
-                height: image.height,
-                channels: 3,
-                data: image.data.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect(),
-            };
+            let rgb = image.without_alpha();
             let mut alpha = Bitmap::new(image.width, image.height, 1);
             alpha.data = image.data.chunks_exact(4).map(|p| p[3]).collect();
             write_image(&output, &rgb, &[(&["A"], alpha)])?;

@@ -69,6 +69,15 @@ impl Bitmap {
         }
     }
 
+    /// The RGB channels of an RGBA image (other images as they are).
+    pub fn without_alpha(&self) -> Bitmap {
+        if self.channels != 4 {
+            return self.clone();
+        }
+        let data = self.data.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        Bitmap { width: self.width, height: self.height, channels: 3, data }
+    }
+
     /// Number of NaN or infinite values.
     pub fn non_finite_count(&self) -> usize {
         self.data.iter().filter(|v| !v.is_finite()).count()

@@ -128,6 +128,29 @@ pub enum TextureDesc {
     },
     /// Tiling and blending of an exemplar, optionally deformed (paper 000 Sec. 3).
     TilingBlending(Box<TilingBlendingDesc>),
+    /// A partition-of-unity parametric texture (paper 002): a named preset of Sec. 3,
+    /// evaluated at every lookup.
+    Pups {
+        /// The preset (`noise`, `octaves`, `turbulence`, `cells`, `clustered-cells`,
+        /// `multiscale-cells`, `cow`, `space-giraffe`, `reference-labels`, `iterative`,
+        /// `progressive-cow`, `progressive-giraffe`, `label-ramp`).
+        preset: crate::pups::Preset,
+        /// About how many control points its base layer has over the unit square (default 700).
+        points: Option<u32>,
+        /// Seed of the points and their attributes (default 0).
+        seed: Option<u64>,
+        /// Whether the texture tiles (a periodic domain; default false).
+        tileable: Option<bool>,
+        /// Orientation strength of Eq. 4 (default 0.5).
+        epsilon: Option<f32>,
+        /// Axis length scale of Fig. 4 (default 1).
+        axis_scale: Option<f32>,
+        /// A grey reference image for `reference-labels` and `iterative`.
+        reference: Option<String>,
+        /// Multiplier of the texture coordinates (default [1, 1]; a tileable texture repeats).
+        #[serde(default = "unit_scale")]
+        scale: [f32; 2],
+    },
     /// A tile image written by `tessera tiles synth` (paper 001), for a quad mesh whose
     /// texture coordinates `tessera tiles map` assigned: each lookup filters one tile only.
     QuadTiles {

@@ -19,6 +19,7 @@ use crate::limits;
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
 };
+use crate::pups::{PresetParams, PupsTexture};
 use crate::texture::tiling_blending::{
     Blend, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
 };
@@ -313,7 +314,7 @@ impl<'a> Loader<'a> {
             TextureDesc::Image { colorspace, .. } | TextureDesc::QuadTiles { colorspace, .. } => {
                 colorspace.unwrap_or(role_space)
             }
-            TextureDesc::TilingBlending(_) => role_space,
+            TextureDesc::TilingBlending(_) | TextureDesc::Pups { .. } => role_space,
         };
         let key = (name.to_string(), space);
         if let Some(t) = self.built_textures.get(&key) {
@@ -352,6 +353,30 @@ impl<'a> Loader<'a> {
                 })
             }
             TextureDesc::TilingBlending(d) => self.tiling_blending(name, d, role)?,
+            TextureDesc::Pups { preset, points, seed, tileable, epsilon, axis_scale, reference, scale } => {
+                let defaults = PresetParams::default();
+                let reference = match reference {
+                    Some(file) => Some(
+                        read_bitmap(&self.resolve_path(file), ColorSpace::Linear)
+                            .map_err(|e| e.in_scene(self.path, format!("textures.{name}.reference")))?,
+                    ),
+                    None => None,
+                };
+                let params = PresetParams {
+                    points: points.unwrap_or(defaults.points),
+                    seed: seed.unwrap_or(defaults.seed),
+                    tileable: tileable.unwrap_or(defaults.tileable),
+                    epsilon: epsilon.unwrap_or(defaults.epsilon),
+                    axis_scale: axis_scale.unwrap_or(defaults.axis_scale),
+                    reference,
+                };
+                if !scale.iter().all(|v| v.is_finite()) {
+                    return Err(self.error(format!("textures.{name}: scale must be finite")));
+                }
+                let texture = PupsTexture::preset(*preset, &params)
+                    .map_err(|msg| self.error(format!("textures.{name}: {msg}")))?;
+                Texture::Pups(Arc::new(texture), Vec2::from(*scale))
+            }
             TextureDesc::QuadTiles { filename, conditions, filter, .. } => {
                 let file = self.resolve_path(filename);
                 let bitmap =

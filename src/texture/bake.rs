@@ -20,16 +20,22 @@ pub enum BakeFootprint {
 /// square (v near 1), as the texture conventions of DESIGN.md section 3 lay images out, so the
 /// bake of an image texture at the image's resolution with point lookups is the image itself.
 pub fn bake(texture: &Texture, res: usize, footprint: BakeFootprint) -> Bitmap {
-    let mut out = Bitmap::new(res, res, 4);
+    bake_rect(texture, res, res, footprint)
+}
+
+/// [`bake`] at `width` x `height` texel centres.
+pub fn bake_rect(texture: &Texture, width: usize, height: usize, footprint: BakeFootprint) -> Bitmap {
+    let mut out = Bitmap::new(width, height, 4);
+    let size = Vec2::new(width as f32, height as f32);
     let step = match footprint {
-        BakeFootprint::Texel => 1.0 / res as f32,
-        BakeFootprint::Point => 0.0,
+        BakeFootprint::Texel => 1.0 / size,
+        BakeFootprint::Point => Vec2::ZERO,
     };
-    out.data.par_chunks_mut(res * 4).enumerate().for_each(|(row, line)| {
-        let v = (res - 1 - row) as f32 + 0.5;
+    out.data.par_chunks_mut(width * 4).enumerate().for_each(|(row, line)| {
+        let v = (height - 1 - row) as f32 + 0.5;
         for (col, px) in line.chunks_exact_mut(4).enumerate() {
-            let uv = Vec2::new(col as f32 + 0.5, v) / res as f32;
-            let ctx = TexCtx { uv, duv_dx: Vec2::new(step, 0.0), duv_dy: Vec2::new(0.0, step), uv_mirrored: None };
+            let uv = Vec2::new(col as f32 + 0.5, v) / size;
+            let ctx = TexCtx { uv, duv_dx: Vec2::new(step.x, 0.0), duv_dy: Vec2::new(0.0, step.y), uv_mirrored: None };
             px.copy_from_slice(&texture.eval(&ctx).to_array());
         }
     });

@@ -9,7 +9,7 @@ mod mipmap;
 mod quad_tiles;
 pub mod tiling_blending;
 
-pub use bake::{BakeFootprint, bake};
+pub use bake::{BakeFootprint, bake, bake_rect};
 pub use mipmap::{Filter, MipMap};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
@@ -108,6 +108,8 @@ pub enum Texture {
     TilingBlending(TilingBlending),
     /// A tile image of paper 001 read tile by tile (a quad mesh mapped by `tessera tiles map`).
     QuadTiles(QuadTilesTexture),
+    /// A partition-of-unity parametric texture (paper 002), its texture coordinates scaled.
+    Pups(Arc<crate::pups::PupsTexture>, Vec2),
 }
 
 impl Texture {
@@ -118,6 +120,7 @@ impl Texture {
             Texture::Image(t) => t.eval(ctx),
             Texture::TilingBlending(t) => t.eval(ctx),
             Texture::QuadTiles(t) => t.eval(ctx),
+            Texture::Pups(t, scale) => t.eval(ctx.uv * *scale),
         }
     }
 
@@ -146,6 +149,7 @@ impl Texture {
             Texture::Image(t) => t.filter != Filter::None,
             Texture::TilingBlending(t) => t.uses_footprint(),
             Texture::QuadTiles(t) => t.filter != Filter::None,
+            Texture::Pups(..) => false,
         }
     }
 
@@ -155,6 +159,7 @@ impl Texture {
             Texture::Image(t) => t.mipmap.memory_bytes(),
             Texture::TilingBlending(t) => t.memory_bytes(),
             Texture::QuadTiles(t) => t.memory_bytes(),
+            Texture::Pups(t, _) => t.memory_bytes(),
         }
     }
 }

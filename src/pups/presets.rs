@@ -1,0 +1,450 @@
+//! The textures of paper 002 Sec. 3 as named presets: point distributions and attribute
+//! assignments that build one or more PUPs fields, summed into a [`PupsTexture`].
+
+use super::field::{ControlPoints, PupsField};
+use super::points::{Domain, poisson_disk, spacing_for_count};
+use crate::image::Bitmap;
+use crate::sampling::Sampler;
+use glam::{Vec2, Vec3, Vec4};
+
+/// The named presets, each after a figure of the paper.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Preset {
+    /// Fig. 7: random values at Poisson disk points, interpolated (Perlin-like noise).
+    Noise,
+    /// Fig. 6, Eq. 5: four octaves of noise, each with twice the density and half the amplitude.
+    Octaves,
+    /// Fig. 8: the octaves folded (2 |T - 0.5|) and summed (Perlin turbulence).
+    Turbulence,
+    /// Fig. 9a: one cell per point, oriented points curving the borders (Voronoi-like cells).
+    Cells,
+    /// Fig. 9b: cells of three or four points.
+    ClusteredCells,
+    /// Fig. 10: four layers of grey cells of increasing density, summed like octaves.
+    MultiscaleCells,
+    /// Fig. 11: random binary labels (cow).
+    Cow,
+    /// Fig. 12: spots ringed by pairs of inner (spot) and outer (background) points.
+    SpaceGiraffe,
+    /// Fig. 13: labels drawn with the intensity of a reference image as probability.
+    ReferenceLabels,
+    /// Fig. 14: four rounds of reference labels, each with twice the points, its probabilities
+    /// read from the previous round's interpolated intensity (fractal boundaries).
+    Iterative,
+    /// Fig. 15: cow labels on points whose density grows from left to right.
+    ProgressiveCow,
+    /// Fig. 16: space giraffe spots whose density grows from left to right.
+    ProgressiveGiraffe,
+    /// Fig. 17: stationary points labelled white with a probability that grows with x.
+    LabelRamp,
+}
+
+impl Preset {
+    /// Every preset, in the paper's order.
+    pub const ALL: [Preset; 13] = [
+        Preset::Noise,
+        Preset::Octaves,
+        Preset::Turbulence,
+        Preset::Cells,
+        Preset::ClusteredCells,
+        Preset::MultiscaleCells,
+        Preset::Cow,
+        Preset::SpaceGiraffe,
+        Preset::ReferenceLabels,
+        Preset::Iterative,
+        Preset::ProgressiveCow,
+        Preset::ProgressiveGiraffe,
+        Preset::LabelRamp,
+    ];
+
+    /// The preset's name as the command line and scenes spell it (kebab case).
+    pub fn name(self) -> String {
+        clap::ValueEnum::to_possible_value(&self).map_or_else(String::new, |v| v.get_name().to_string())
+    }
+}
+
+/// What a preset is built from.
+#[derive(Clone, Debug)]
+pub struct PresetParams {
+    /// About how many control points the preset's base layer has over the unit square.
+    pub points: u32,
+    /// Seed of the points and their attributes.
+    pub seed: u64,
+    /// Whether the texture tiles (a periodic domain).
+    pub tileable: bool,
+    /// Orientation strength epsilon of Eq. 4 (the paper's default 0.5).
+    pub epsilon: f32,
+    /// Axis length scale (Fig. 4; 1 is the paper's normal length).
+    pub axis_scale: f32,
+    /// A grey reference image for the label presets of Fig. 13-14 (a built-in disc and ramp
+    /// when None).
+    pub reference: Option<Bitmap>,
+}
+
+impl Default for PresetParams {
+    fn default() -> Self {
+        PresetParams { points: 700, seed: 0, tileable: false, epsilon: 0.5, axis_scale: 1.0, reference: None }
+    }
+}
+
+/// How a layer turns its field into a colour.
+#[derive(Clone, Debug)]
+enum Output {
+    /// The interpolated value (Eq. 3).
+    Value,
+    /// The value folded: 2 |T - 0.5| (turbulence).
+    Folded,
+    /// The colour of the label with the largest weight.
+    Label(Vec<Vec3>),
+}
+
+/// One field of a texture, its output and its amplitude.
+#[derive(Clone, Debug)]
+struct Layer {
+    field: PupsField,
+    output: Output,
+    amplitude: f32,
+}
+
+/// A PUPs texture: the sum of its layers' amplitudes times their outputs.
+#[derive(Clone, Debug)]
+pub struct PupsTexture {
+    layers: Vec<Layer>,
+}
+
+impl PupsTexture {
+    /// RGBA value at `uv` (alpha 1).
+    pub fn eval(&self, uv: Vec2) -> Vec4 {
+        let mut sum = Vec3::ZERO;
+        for layer in &self.layers {
+            let v = match &layer.output {
+                Output::Value => layer.field.value(uv),
+                Output::Folded => (layer.field.value(uv) - Vec3::splat(0.5)).abs() * 2.0,
+                Output::Label(palette) => palette[layer.field.label(uv) as usize % palette.len()],
+            };
+            sum += v * layer.amplitude;
+        }
+        sum.extend(1.0)
+    }
+
+    /// Control points over all layers.
+    pub fn point_count(&self) -> usize {
+        self.layers.iter().map(|l| l.field.point_count()).sum()
+    }
+
+    /// Approximate memory held, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        // Centres, axes (about six per centre), grid entries and attributes.
+        self.point_count() * (8 + 6 * 8 + 8 * 4 + 40)
+    }
+
+    /// The texture of `preset` with `params`.
+    pub fn preset(preset: Preset, params: &PresetParams) -> Result<Self, String> {
+        Builder::new(params)?.build(preset)
+    }
+
+    /// A single field read as values (a points file's texture).
+    pub fn from_field(field: PupsField, labels: Option<Vec<Vec3>>) -> Self {
+        let output = labels.map_or(Output::Value, Output::Label);
+        PupsTexture { layers: vec![Layer { field, output, amplitude: 1.0 }] }
+    }
+}
+
+/// Builds presets: draws points, assigns attributes, makes fields.
+struct Builder<'a> {
+    params: &'a PresetParams,
+    domain: Domain,
+    sampler: Sampler,
+    spacing: f32,
+}
+
+/// The two colours of binary labels (cow, giraffe backgrounds): near black and near white.
+const BLACK_WHITE: [Vec3; 2] = [Vec3::new(0.03, 0.03, 0.03), Vec3::new(0.9, 0.88, 0.85)];
+/// Space giraffe: spots and the background between them.
+const GIRAFFE: [Vec3; 2] = [Vec3::new(0.85, 0.75, 0.55), Vec3::new(0.35, 0.17, 0.05)];
+
+impl<'a> Builder<'a> {
+    fn new(params: &'a PresetParams) -> Result<Self, String> {
+        if !(3..=super::points::MAX_POINTS as u32).contains(&params.points) {
+            return Err(format!("{} points: give 3 to {}", params.points, super::points::MAX_POINTS));
+        }
+        let spacing = spacing_for_count(params.points);
+        let domain = if params.tileable { Domain::Periodic } else { Domain::Square { margin: 3.0 * spacing } };
+        Ok(Builder { params, domain, sampler: Sampler::new(params.seed, 0x7075_7073, 0), spacing })
+    }
+
+    /// A Poisson disk distribution with `spacing` times the base spacing (uniform), or from
+    /// `dense` to `sparse` times it across x (a density ramp, denser to the right).
+    fn points(&mut self, scale: f32, ramp: Option<(f32, f32)>) -> Result<Vec<Vec2>, String> {
+        let seed = (self.sampler.next_1d() * 16_777_216.0) as u64;
+        let base = self.spacing * scale;
+        let domain = match self.domain {
+            Domain::Square { .. } => Domain::Square { margin: 3.0 * base * ramp.map_or(1.0, |r| r.0) },
+            periodic => periodic,
+        };
+        match ramp {
+            None => poisson_disk(domain, base, base, &|_| base, seed),
+            Some((sparse, dense)) => {
+                let spacing = |p: Vec2| base * (sparse + (dense - sparse) * p.x.clamp(0.0, 1.0));
+                poisson_disk(domain, base * dense.min(sparse), base * dense.max(sparse), &spacing, seed)
+            }
+        }
+    }
+
+    fn random_orientations(&mut self, n: usize) -> Vec<Vec3> {
+        (0..n)
+            .map(|_| {
+                let a = self.sampler.next_1d() * std::f32::consts::TAU;
+                Vec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect()
+    }
+
+    fn field(&self, points: &ControlPoints) -> Result<PupsField, String> {
+        PupsField::new(points, self.domain, self.params.axis_scale, self.params.epsilon)
+    }
+
+    /// Random grey values, one label per point.
+    fn value_layer(&mut self, scale: f32, output: Output, amplitude: f32) -> Result<Layer, String> {
+        let positions = self.points(scale, None)?;
+        let values = positions.iter().map(|_| Vec3::splat(self.sampler.next_1d())).collect();
+        let labels = (0..positions.len() as u32).collect();
+        let field = self.field(&ControlPoints::new(positions, values, labels))?;
+        Ok(Layer { field, output, amplitude })
+    }
+
+    /// Labelled points: `label(point, sampler)` for each, oriented at random.
+    fn label_layer(
+        &mut self,
+        positions: Vec<Vec2>,
+        label: &mut dyn FnMut(Vec2, &mut Sampler) -> u32,
+        palette: Vec<Vec3>,
+        amplitude: f32,
+    ) -> Result<Layer, String> {
+        let labels: Vec<u32> = positions.iter().map(|p| label(*p, &mut self.sampler)).collect();
+        let values = labels.iter().map(|&l| palette[l as usize % palette.len()]).collect();
+        let mut points = ControlPoints::new(positions, values, labels);
+        points.orientations = self.random_orientations(points.positions.len());
+        Ok(Layer { field: self.field(&points)?, output: Output::Label(palette), amplitude })
+    }
+
+    /// A palette of `n` random greys or colours.
+    fn random_palette(&mut self, n: usize, colour: bool) -> Vec<Vec3> {
+        (0..n)
+            .map(|_| {
+                let g = self.sampler.next_1d();
+                if colour {
+                    Vec3::new(g, self.sampler.next_1d(), self.sampler.next_1d()) * 0.8 + Vec3::splat(0.1)
+                } else {
+                    Vec3::splat(g)
+                }
+            })
+            .collect()
+    }
+
+    /// The reference image's intensity at `p` (the unit square, v up), or the built-in one: a
+    /// disc on a ramp.
+    fn reference(&self, p: Vec2) -> f32 {
+        let p = p.clamp(Vec2::ZERO, Vec2::ONE);
+        match &self.params.reference {
+            Some(image) => {
+                let x = ((p.x * image.width as f32) as usize).min(image.width - 1);
+                let y = (((1.0 - p.y) * image.height as f32) as usize).min(image.height - 1);
+                let c = image.pixel(x, y);
+                (c.x + c.y + c.z) / 3.0
+            }
+            None => {
+                let disc = if p.distance(Vec2::new(0.45, 0.55)) < 0.28 { 1.0 } else { 0.0 };
+                (disc * 0.85 + p.x * 0.3).min(1.0)
+            }
+        }
+    }
+
+    /// The space giraffe's points (Sec. 3.2): spot centres, and around each pairs of an inner
+    /// (spot) and an outer (background) point at n angles, n in [10, 20], radii in [0, r], r half
+    /// the distance to the nearest centre.
+    fn giraffe(&mut self, ramp: Option<(f32, f32)>) -> Result<Layer, String> {
+        let centres = self.points(2.5, ramp)?;
+        let nearest: Vec<f32> = centres
+            .iter()
+            .map(|c| {
+                centres.iter().filter(|o| *o != c).map(|o| self.domain.offset(*c, *o).length()).fold(f32::MAX, f32::min)
+            })
+            .collect();
+        let mut positions = Vec::new();
+        let mut labels = Vec::new();
+        for (c, d) in centres.iter().zip(nearest) {
+            let r = 0.5 * d;
+            positions.push(*c);
+            labels.push(1);
+            let n = 10 + (self.sampler.next_1d() * 11.0) as usize;
+            let phase = self.sampler.next_1d();
+            for k in 0..n {
+                let angle = std::f32::consts::TAU * (k as f32 + phase) / n as f32;
+                let dir = Vec2::new(angle.cos(), angle.sin());
+                let (a, b) = (self.sampler.next_1d() * r, self.sampler.next_1d() * r);
+                let (inner, outer) = (a.min(b).max(0.15 * r), a.max(b).max(0.3 * r));
+                for (radius, label) in [(inner, 1), (outer, 0)] {
+                    let p = *c + dir * radius;
+                    positions.push(if self.domain == Domain::Periodic { p - p.floor() } else { p });
+                    labels.push(label);
+                }
+            }
+        }
+        let mut labels = labels.into_iter();
+        self.label_layer(positions, &mut |_, _| labels.next().expect("one label per point"), GIRAFFE.to_vec(), 1.0)
+    }
+
+    fn build(mut self, preset: Preset) -> Result<PupsTexture, String> {
+        let octave_norm = 1.0 / (1.0 + 0.5 + 0.25 + 0.125);
+        let layers = match preset {
+            Preset::Noise => vec![self.value_layer(1.0, Output::Value, 1.0)?],
+            Preset::Octaves | Preset::Turbulence => {
+                let output = if preset == Preset::Octaves { Output::Value } else { Output::Folded };
+                // Octave i: spacing 2^(3 - i) times the base (the finest octave has the
+                // points asked for), amplitude 2^-i.
+                (0..4)
+                    .map(|i| {
+                        let s = 0.5f32.powi(i);
+                        self.value_layer(8.0 * s, output.clone(), s * octave_norm)
+                    })
+                    .collect::<Result<_, _>>()?
+            }
+            Preset::Cells | Preset::MultiscaleCells => {
+                let count = if preset == Preset::Cells { 1 } else { 4 };
+                let mut layers = Vec::new();
+                for i in 0..count {
+                    let s = 0.5f32.powi(i);
+                    let positions = self.points(if count == 1 { 1.0 } else { 8.0 * s }, None)?;
+                    let palette = self.random_palette(positions.len(), preset == Preset::Cells);
+                    let mut next = 0..;
+                    let amplitude = if count == 1 { 1.0 } else { s * octave_norm };
+                    layers.push(self.label_layer(
+                        positions,
+                        &mut |_, _| next.next().unwrap_or(0),
+                        palette,
+                        amplitude,
+                    )?);
+                }
+                layers
+            }
+            Preset::ClusteredCells => {
+                let positions = self.points(1.0, None)?;
+                let labels = clusters(&positions, self.domain, &mut self.sampler);
+                let palette = self.random_palette(positions.len(), true);
+                let mut labels = labels.into_iter();
+                vec![self.label_layer(positions, &mut |_, _| labels.next().unwrap_or(0), palette, 1.0)?]
+            }
+            Preset::Cow | Preset::ProgressiveCow => {
+                let ramp = (preset == Preset::ProgressiveCow).then_some((2.0, 0.5));
+                let positions = self.points(1.0, ramp)?;
+                vec![self.label_layer(
+                    positions,
+                    &mut |_, s| u32::from(s.next_1d() < 0.5),
+                    BLACK_WHITE.to_vec(),
+                    1.0,
+                )?]
+            }
+            Preset::SpaceGiraffe => vec![self.giraffe(None)?],
+            Preset::ProgressiveGiraffe => vec![self.giraffe(Some((2.0, 0.6)))?],
+            Preset::LabelRamp => {
+                let positions = self.points(1.0, None)?;
+                vec![self.label_layer(
+                    positions,
+                    &mut |p, s| u32::from(s.next_1d() < p.x),
+                    BLACK_WHITE.to_vec(),
+                    1.0,
+                )?]
+            }
+            Preset::ReferenceLabels => {
+                let positions = self.points(1.0, None)?;
+                let intensity: Vec<f32> = positions.iter().map(|p| self.reference(*p)).collect();
+                let mut k = 0;
+                let mut label = |_: Vec2, s: &mut Sampler| {
+                    k += 1;
+                    u32::from(s.next_1d() < intensity[k - 1])
+                };
+                vec![self.label_layer(positions, &mut label, BLACK_WHITE.to_vec(), 1.0)?]
+            }
+            Preset::Iterative => {
+                // Round 0 reads the reference; each later round doubles the points and draws
+                // each label with the previous round's interpolated intensity as probability.
+                let mut previous: Option<PupsField> = None;
+                for round in 0..4 {
+                    let positions = self.points(1.5 * 0.5f32.powf(round as f32 * 0.5), None)?;
+                    let values: Vec<Vec3> = positions
+                        .iter()
+                        .map(|p| {
+                            let probability = match &previous {
+                                None => self.reference(*p),
+                                Some(field) => field.value(*p).x,
+                            };
+                            Vec3::splat(f32::from(u8::from(self.sampler.next_1d() < probability)))
+                        })
+                        .collect();
+                    let labels = values.iter().map(|v| v.x as u32).collect();
+                    previous = Some(self.field(&ControlPoints::new(positions, values, labels))?);
+                }
+                let field = previous.expect("four rounds");
+                vec![Layer { field, output: Output::Value, amplitude: 1.0 }]
+            }
+        };
+        Ok(PupsTexture { layers })
+    }
+}
+
+/// Groups of three or four neighbouring points (Fig. 9b): each point not yet grouped starts a
+/// group with its nearest ungrouped points within a few spacings (found through a grid of
+/// buckets of that size).
+fn clusters(points: &[Vec2], domain: Domain, sampler: &mut Sampler) -> Vec<u32> {
+    let mut label = vec![u32::MAX; points.len()];
+    let mut next = 0;
+    let (lo, hi) =
+        points.iter().fold((Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)), |(a, b), p| (a.min(*p), b.max(*p)));
+    let reach = 4.0 / (points.len() as f32).sqrt();
+    let buckets = (((hi - lo).max_element() / reach).ceil() as usize).clamp(1, 4096);
+    let bucket = |p: Vec2| {
+        let b = ((p - lo) / (hi - lo).max(Vec2::splat(1e-9)) * buckets as f32).floor();
+        ((b.x as usize).min(buckets - 1), (b.y as usize).min(buckets - 1))
+    };
+    let mut grid: Vec<Vec<usize>> = vec![Vec::new(); buckets * buckets];
+    for (j, p) in points.iter().enumerate() {
+        let (x, y) = bucket(*p);
+        grid[y * buckets + x].push(j);
+    }
+    for i in 0..points.len() {
+        if label[i] != u32::MAX {
+            continue;
+        }
+        let size = 3 + usize::from(sampler.next_1d() < 0.5);
+        let (bx, by) = bucket(points[i]);
+        let wrap = |v: isize| {
+            if domain == Domain::Periodic {
+                Some(v.rem_euclid(buckets as isize) as usize)
+            } else {
+                (0..buckets as isize).contains(&v).then_some(v as usize)
+            }
+        };
+        let mut near: Vec<(f32, usize)> = Vec::new();
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let (Some(x), Some(y)) = (wrap(bx as isize + dx), wrap(by as isize + dy)) else { continue };
+                for &j in &grid[y * buckets + x] {
+                    if j != i && label[j] == u32::MAX {
+                        near.push((domain.offset(points[i], points[j]).length(), j));
+                    }
+                }
+            }
+        }
+        near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        // A small periodic grid visits a bucket more than once.
+        near.dedup_by_key(|n| n.1);
+        label[i] = next;
+        for &(_, j) in near.iter().take(size - 1) {
+            label[j] = next;
+        }
+        next += 1;
+    }
+    label
+}
