@@ -19,6 +19,9 @@
 //!   memory it adds (Linux), against pairing the same edges through a hash map; and the
 //!   synthesis of a 4 x 4 tile image of 256-texel tiles from `scenes/textures/rocks_basecolor.jpg`,
 //!   against resampling as many texels bilinearly.
+//! - Paper 002's PUPs: the paper's case, a 1000 x 1000 image of the `noise` preset from 700
+//!   control points (the paper reports 30 s), and single lookups per second against the bitmap
+//!   lookup of the texture figures, measured in the same run.
 
 use glam::{Mat2, Vec2};
 use rayon::prelude::*;
@@ -81,6 +84,8 @@ pub enum Suite {
     Deform,
     /// Paper 001: mapping 1M quads, synthesising 16 tiles of 256 texels.
     Tiles,
+    /// Paper 002: a 1000 x 1000 PUPs image from 700 points; lookups per second.
+    Pups,
 }
 
 /// Run the benchmarks of `suites` and print a table. `scene_dir` holds the shipped scenes.
@@ -105,6 +110,9 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> R
     }
     if suites.contains(&Suite::Tiles) {
         tiles(scene_dir, runs, &pool)?;
+    }
+    if suites.contains(&Suite::Pups) {
+        pups(scene_dir, runs, &pool)?;
     }
     Ok(())
 }
@@ -408,6 +416,51 @@ fn tiles(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> 
          bilinearly ({resampling:.4} s)",
         pool.current_num_threads(),
         seconds / resampling
+    );
+    Ok(())
+}
+
+fn pups(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
+    use tessera::pups::{Preset, PresetParams, PupsTexture};
+    let params = PresetParams { points: 700, ..Default::default() };
+    let texture = Arc::new(PupsTexture::preset(Preset::Noise, &params).map_err(|m| Error::param("bench", m))?);
+    let pups = Texture::Pups(texture.clone(), Vec2::ONE);
+    let mut times = Vec::new();
+    for _ in 0..runs {
+        let start = Instant::now();
+        let image =
+            pool.install(|| tessera::texture::bake_rect(&pups, 1000, 1000, tessera::texture::BakeFootprint::Point));
+        times.push(start.elapsed().as_secs_f64());
+        std::hint::black_box(image.data.len());
+    }
+    let seconds = median(times);
+    println!(
+        "pups       1000 x 1000 image of `noise` from {} control points, {} threads: {seconds:.3} s ({:.0}x the paper's 30 s; \
+         target < 0.1 s)",
+        texture.point_count(),
+        pool.current_num_threads(),
+        30.0 / seconds
+    );
+    // Lookups one at a time on one thread, against the bitmap's, over the same raster.
+    let bitmap = Texture::Image(ImageTexture {
+        mipmap: Arc::new(MipMap::new(read_bitmap(&scene_dir.join("textures/bark.jpg"), ColorSpace::Srgb)?)),
+        filter: Filter::None,
+        scale: Vec2::ONE,
+        offset: Vec2::ZERO,
+    });
+    let lookups: Vec<TexCtx> = (0..1_000_000)
+        .map(|i| TexCtx {
+            uv: Vec2::new((i % 1000) as f32 + 0.5, (i / 1000) as f32 + 0.5) / 1000.0,
+            ..Default::default()
+        })
+        .collect();
+    let (pups_rate, bitmap_rate) =
+        (lookups_per_second(runs, &pups, &lookups), lookups_per_second(runs, &bitmap, &lookups));
+    println!(
+        "pups       lookups on 1 thread: {:.2} M/s, {:.1}x the cost of a bilinear bitmap lookup ({:.1} M/s)",
+        pups_rate,
+        bitmap_rate / pups_rate,
+        bitmap_rate
     );
     Ok(())
 }

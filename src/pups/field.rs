@@ -76,7 +76,8 @@ pub fn axial_weight(p: f32) -> f32 {
 /// Eq. 4: weight `w` shifted by K = epsilon eta.
 #[inline]
 pub fn shifted_weight(w: f32, k: f32) -> f32 {
-    if k >= 0.0 { w.powf(1.0 - k) } else { w.powf(1.0 / (1.0 + k)) }
+    // libm: the same bits on every platform, so that presets reproduce their golden images.
+    if k >= 0.0 { libm::powf(w, 1.0 - k) } else { libm::powf(w, 1.0 / (1.0 + k)) }
 }
 
 /// Clip the convex polygon `poly` to the half-plane d . q <= 1 with d = x - c.
@@ -120,44 +121,14 @@ impl PupsField {
         if let Some(i) = points.values.iter().position(|v| !v.is_finite()) {
             return Err(format!("control point {} has a non-finite value", i + 1));
         }
-        // Centres: the points (wrapped into the square when periodic) and their copies.
-        let mut centres: Vec<Vec2> = Vec::with_capacity(n);
-        let mut source: Vec<u32> = Vec::with_capacity(n);
-        match domain {
+        let (centres, source, neighbours) = match domain {
             Domain::Square { .. } => {
-                centres.extend(&points.positions);
-                source.extend(0..n as u32);
+                let centres = points.positions.clone();
+                let neighbours = delaunay_neighbours(&centres)?;
+                (centres, (0..n as u32).collect(), neighbours)
             }
-            Domain::Periodic => {
-                let wrapped: Vec<Vec2> = points.positions.iter().map(|p| *p - p.floor()).collect();
-                centres.extend(&wrapped);
-                source.extend(0..n as u32);
-                let margin = (6.0 / (n as f32).sqrt()).min(1.0);
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        if (dx, dy) == (0, 0) {
-                            continue;
-                        }
-                        let shift = Vec2::new(dx as f32, dy as f32);
-                        for (i, p) in wrapped.iter().enumerate() {
-                            let q = *p + shift;
-                            if q.cmpge(Vec2::splat(-margin)).all() && q.cmple(Vec2::splat(1.0 + margin)).all() {
-                                centres.push(q);
-                                source.push(i as u32);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        if centres.len() > super::points::MAX_POINTS {
-            return Err(format!(
-                "{} control points (with the copies of a periodic domain), over tessera's limit of {}",
-                centres.len(),
-                super::points::MAX_POINTS
-            ));
-        }
-        let neighbours = delaunay_neighbours(&centres)?;
+            Domain::Periodic => periodic_triangulation(&points.positions, axis_scale)?,
+        };
         // Axes, and each centre's support clipped from the box around all centres.
         let (lo, hi) =
             centres.iter().fold((Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)), |(lo, hi), c| (lo.min(*c), hi.max(*c)));
@@ -309,6 +280,54 @@ impl PupsField {
     }
 }
 
+/// The points wrapped into the unit square and their copies shifted by its sides over a band
+/// around it, triangulated: centres, the point each is a copy of, the neighbours. The band is
+/// three axis lengths of the longest edge from a point of the square wide (or the whole 3 x 3
+/// block), so that every centre whose weight reaches into the square has its whole periodic
+/// neighbourhood; a first guess from the point count is widened until that holds.
+#[allow(clippy::type_complexity)]
+fn periodic_triangulation(positions: &[Vec2], axis_scale: f32) -> Result<(Vec<Vec2>, Vec<u32>, Vec<Vec<u32>>), String> {
+    let n = positions.len();
+    let wrapped: Vec<Vec2> = positions.iter().map(|p| *p - p.floor()).collect();
+    let mut margin = (6.0 / (n as f32).sqrt()).min(1.0);
+    loop {
+        let mut centres = wrapped.clone();
+        let mut source: Vec<u32> = (0..n as u32).collect();
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                if (dx, dy) == (0, 0) {
+                    continue;
+                }
+                let shift = Vec2::new(dx as f32, dy as f32);
+                for (i, p) in wrapped.iter().enumerate() {
+                    let q = *p + shift;
+                    if q.cmpge(Vec2::splat(-margin)).all() && q.cmple(Vec2::splat(1.0 + margin)).all() {
+                        centres.push(q);
+                        source.push(i as u32);
+                    }
+                }
+            }
+        }
+        if centres.len() > super::points::MAX_POINTS {
+            return Err(format!(
+                "{} control points (with the copies of a periodic domain), over tessera's limit of {}",
+                centres.len(),
+                super::points::MAX_POINTS
+            ));
+        }
+        let neighbours = delaunay_neighbours(&centres)?;
+        let longest = (0..n)
+            .flat_map(|i| neighbours[i].iter().map(move |&j| (i, j)))
+            .map(|(i, j)| centres[i].distance(centres[j as usize]))
+            .fold(0.0f32, f32::max);
+        let needed = 3.0 * axis_scale * longest;
+        if margin >= 1.0 || margin >= needed {
+            return Ok((centres, source, neighbours));
+        }
+        margin = needed.min(1.0);
+    }
+}
+
 /// The Delaunay neighbours of every point (spade), in the order spade walks them.
 fn delaunay_neighbours(points: &[Vec2]) -> Result<Vec<Vec<u32>>, String> {
     use spade::{DelaunayTriangulation, Point2, Triangulation};
@@ -438,6 +457,44 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Labels (cells): constant around every control point (its own label within a fifth of
+    /// the spacing) and changing only where the two largest weights meet: wherever the label
+    /// differs between neighbouring samples 1e-3 apart, the two winners' weights at the
+    /// midpoint differ by no more than their slopes allow over that step.
+    #[test]
+    fn labels_are_constant_in_cells_and_change_only_at_boundaries() {
+        let f = field(Domain::Periodic, 0.5, 5);
+        for (i, c) in f.centres[..f.point_count()].iter().enumerate() {
+            for k in 0..8 {
+                let a = std::f32::consts::TAU * k as f32 / 8.0;
+                let u = *c + Vec2::new(a.cos(), a.sin()) * 0.016;
+                assert_eq!(f.label(u), f.labels[i], "around point {i}");
+            }
+        }
+        let top_two = |u: Vec2| {
+            let mut w: Vec<(f32, u32)> = Vec::new();
+            f.for_each_weight(u, |i, x| w.push((x, f.labels[i])));
+            w.sort_by(|a, b| b.0.total_cmp(&a.0));
+            w
+        };
+        let step = 1e-3;
+        let mut changes = 0;
+        for y in 0..200 {
+            for x in 0..999 {
+                let (a, b) =
+                    (Vec2::new(x as f32 * step, y as f32 / 200.0), Vec2::new((x + 1) as f32 * step, y as f32 / 200.0));
+                let (la, lb) = (f.label(a), f.label(b));
+                if la != lb {
+                    changes += 1;
+                    let w = top_two((a + b) * 0.5);
+                    // Weight slopes are at most a few over the spacing (0.08): 30 per unit.
+                    assert!(w[0].0 - w[1].0 <= 30.0 * step, "label {la} -> {lb} at {a}: weights {w:?}");
+                }
+            }
+        }
+        assert!(changes > 100, "{changes} label changes");
     }
 
     /// A periodic field wraps: the raw field just past the right edge (read through the copies)

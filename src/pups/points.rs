@@ -123,7 +123,7 @@ pub fn poisson_disk(
         for _ in 0..CANDIDATES {
             let s = sampler.next_2d();
             let (radius, angle) = (r * (1.0 + s.x), std::f32::consts::TAU * s.y);
-            let mut p = centre + Vec2::new(angle.cos(), angle.sin()) * radius;
+            let mut p = centre + Vec2::new(libm::cosf(angle), libm::sinf(angle)) * radius;
             if periodic {
                 p -= p.floor();
             } else if p.cmplt(origin).any() || p.cmpge(origin + size).any() {

@@ -196,7 +196,7 @@ impl<'a> Builder<'a> {
         (0..n)
             .map(|_| {
                 let a = self.sampler.next_1d() * std::f32::consts::TAU;
-                Vec3::new(a.cos(), a.sin(), 0.0)
+                Vec3::new(libm::cosf(a), libm::sinf(a), 0.0)
             })
             .collect()
     }
@@ -282,7 +282,7 @@ impl<'a> Builder<'a> {
             let phase = self.sampler.next_1d();
             for k in 0..n {
                 let angle = std::f32::consts::TAU * (k as f32 + phase) / n as f32;
-                let dir = Vec2::new(angle.cos(), angle.sin());
+                let dir = Vec2::new(libm::cosf(angle), libm::sinf(angle));
                 let (a, b) = (self.sampler.next_1d() * r, self.sampler.next_1d() * r);
                 let (inner, outer) = (a.min(b).max(0.15 * r), a.max(b).max(0.3 * r));
                 for (radius, label) in [(inner, 1), (outer, 0)] {
@@ -372,7 +372,7 @@ impl<'a> Builder<'a> {
                 // each label with the previous round's interpolated intensity as probability.
                 let mut previous: Option<PupsField> = None;
                 for round in 0..4 {
-                    let positions = self.points(1.5 * 0.5f32.powf(round as f32 * 0.5), None)?;
+                    let positions = self.points(1.5 * libm::powf(0.5, round as f32 * 0.5), None)?;
                     let values: Vec<Vec3> = positions
                         .iter()
                         .map(|p| {

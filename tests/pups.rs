@@ -1,0 +1,94 @@
+//! Paper 002's presets as a user meets them: each reproduces its golden image, tileable ones
+//! join up across the square's edges, and bad requests are errors.
+
+mod common;
+
+use glam::{Vec2, Vec4};
+use std::process::Command;
+use tessera::image::{ColorSpace, read_bitmap};
+use tessera::pups::{Preset, PresetParams, PupsTexture};
+
+fn texture(preset: Preset, points: u32, seed: u64, tileable: bool) -> PupsTexture {
+    PupsTexture::preset(preset, &PresetParams { points, seed, tileable, ..Default::default() }).unwrap()
+}
+
+/// The bake of a preset at the golden's texel centres (row 0 at the top).
+fn bake(t: &PupsTexture, res: usize) -> Vec<Vec4> {
+    (0..res * res)
+        .map(|i| {
+            let (x, y) = (i % res, i / res);
+            t.eval(Vec2::new(x as f32 + 0.5, (res - 1 - y) as f32 + 0.5) / res as f32)
+        })
+        .collect()
+}
+
+/// The presets are deterministic (libm's functions, counter-based random numbers), so the
+/// goldens match to float rounding; a changed point set or weight would move whole cells.
+#[test]
+fn presets_with_fixed_seeds_reproduce_their_golden_images() {
+    let root = common::repo().join("reference/pups");
+    for (file, t) in [
+        ("turbulence_seed3.exr", texture(Preset::Turbulence, 400, 3, false)),
+        ("cow_seed5_tileable.exr", texture(Preset::Cow, 300, 5, true)),
+    ] {
+        let golden = read_bitmap(&root.join(file), ColorSpace::Linear).unwrap();
+        let baked = bake(&t, 128);
+        let worst = baked
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v.truncate() - golden.pixel(i % 128, i / 128).truncate()).abs().max_element())
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-5, "{file}: differs by {worst}");
+    }
+}
+
+/// Pairs of points 2 h apart across the square's left-right and top-bottom borders (800 of
+/// them) whose colours differ by more than 0.05.
+fn jumps_across_the_borders(t: &PupsTexture, h: f32) -> usize {
+    (0..400)
+        .flat_map(|k| {
+            let s = (k as f32 + 0.5) / 400.0;
+            [(Vec2::new(1.0 - h, s), Vec2::new(h, s)), (Vec2::new(s, 1.0 - h), Vec2::new(s, h))]
+        })
+        .filter(|(a, b)| (t.eval(*a) - t.eval(*b)).abs().max_element() > 0.05)
+        .count()
+}
+
+/// Every preset, tileable: the texture meets itself across the square's edges. Continuity:
+/// pairs 2e-5 apart across a border differ only where a cell boundary happens to pass between
+/// them (at most 1%); the same presets without `tileable` jump on a large share of them.
+#[test]
+fn tileable_presets_join_up_across_the_edges() {
+    for preset in Preset::ALL {
+        let jumps = jumps_across_the_borders(&texture(preset, 300, 1, true), 1e-5);
+        assert!(jumps <= 8, "{}: {jumps} of 800 pairs jump across the border", preset.name());
+    }
+    for preset in [Preset::Noise, Preset::Cells] {
+        let jumps = jumps_across_the_borders(&texture(preset, 300, 1, false), 1e-5);
+        assert!(jumps > 200, "{} (not tileable): only {jumps} of 800 pairs jump", preset.name());
+    }
+}
+
+#[test]
+fn bad_requests_are_clear_errors() {
+    let error =
+        |preset, points| PupsTexture::preset(preset, &PresetParams { points, ..Default::default() }).unwrap_err();
+    assert!(error(Preset::Cow, 10_000_000).contains("give 3 to"));
+    assert!(error(Preset::Noise, 1).contains("give 3 to"));
+    let bad_epsilon = PupsTexture::preset(Preset::Cells, &PresetParams { epsilon: f32::NAN, ..Default::default() });
+    assert!(bad_epsilon.unwrap_err().contains("epsilon"));
+    let bad_axis = PupsTexture::preset(Preset::Noise, &PresetParams { axis_scale: 0.1, ..Default::default() });
+    assert!(bad_axis.unwrap_err().contains("axis scale"));
+    // Through the command line: exit status 1, the preset named, no output written.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cow.png");
+    let run = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .args(["pups", "cow", "--points", "10000000", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("cow") && stderr.contains("10000000") && !stderr.contains("panicked"), "{stderr}");
+    assert!(!out.exists());
+}
