@@ -92,3 +92,42 @@ fn bad_requests_are_clear_errors() {
     assert!(stderr.contains("cow") && stderr.contains("10000000") && !stderr.contains("panicked"), "{stderr}");
     assert!(!out.exists());
 }
+
+/// A `pups` texture in a scene: as a material's colour and as the exemplar of tiling and
+/// blending, rendering finite images.
+#[test]
+fn pups_textures_feed_materials_and_tiling_and_blending() {
+    let (_dir, scene) = common::scene(
+        r#"
+        [render]
+        width = 8
+        height = 8
+        spp = 2
+        [camera]
+        fov = 30
+        eye = [0, 0, 4]
+        target = [0, 0, 0]
+        [environment]
+        type = "constant"
+        radiance = 1
+        [textures.cells]
+        type = "pups"
+        preset = "cells"
+        points = 200
+        tileable = true
+        [textures.tb]
+        type = "tiling_blending"
+        exemplar = "cells"
+        [materials.m]
+        type = "diffuse"
+        reflectance = "tb"
+        [[shapes]]
+        type = "rectangle"
+        material = "m"
+        "#,
+        &[],
+    );
+    let image = common::render_film(&scene).radiance();
+    assert_eq!(image.non_finite_count(), 0);
+    assert!(image.channel_means().iter().all(|&m| m > 0.01));
+}
