@@ -1,7 +1,8 @@
 //! Seeded mutation fuzzing of everything that reads a file: scene loading (the shipped scenes),
 //! OBJ, glTF and GLB meshes, PNG, JPEG, Radiance HDR and OpenEXR images, `tessera deform`'s
 //! mesh reading and maps, `tessera tiles map`'s quad meshes (mapping, subdivision, the OBJ it
-//! writes, a `quad_tiles` texture on it), then a tiny render (every AOV and the variance) and a bake of each
+//! writes, a `quad_tiles` texture on it), PUPs points files (CSV, JSON) as `pups` textures, then
+//! a tiny render (every AOV and the variance) and a bake of each
 //! texture of what loaded. The properties checked, for every case:
 //! - no panic (a panic inside a third-party parser that tessera catches is an error, which is
 //!   fine; one that escapes fails the case),
@@ -45,8 +46,8 @@ static LIVE: AtomicUsize = AtomicUsize::new(0);
 static CURRENT_CASE: AtomicUsize = AtomicUsize::new(usize::MAX);
 /// Per kind of seed: cases run, and cases whose mutated input still loaded as a scene and was
 /// rendered (the fuzzer's depth).
-static CASES: [AtomicUsize; 7] = [const { AtomicUsize::new(0) }; 7];
-static RENDERED: [AtomicUsize; 7] = [const { AtomicUsize::new(0) }; 7];
+static CASES: [AtomicUsize; 8] = [const { AtomicUsize::new(0) }; 8];
+static RENDERED: [AtomicUsize; 8] = [const { AtomicUsize::new(0) }; 8];
 
 #[global_allocator]
 static ALLOCATOR: BudgetAllocator = BudgetAllocator;
@@ -368,6 +369,8 @@ enum Kind {
     /// A quad mesh for `tessera tiles map`: mapped, subdivided, written, and rendered with a
     /// `quad_tiles` texture.
     QuadObj,
+    /// A PUPs points file (CSV or JSON), read by a `pups` texture.
+    PupsPoints,
 }
 
 /// An input to mutate.
@@ -437,6 +440,18 @@ fn seeds() -> Vec<Seed> {
         "strip.obj",
         b"v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\ng a\nf 1 2 5 4\ng b\nf 2 3 6 5\n".to_vec(),
     ));
+    seeds.push(file(
+        Kind::PupsPoints,
+        "points.csv",
+        b"x,y,r,g,b,label,ox,oy,oz\n0.1,0.2,1,0,0,0,1,0,0\n0.9,0.1,0,1,0,1,0,1,0\n0.5,0.8,0,0,1,2,0,0,1\n0.4,0.4,1,1,0,0,1,1,0\n"
+            .to_vec(),
+    ));
+    seeds.push(file(
+        Kind::PupsPoints,
+        "points.json",
+        br#"[{"x":0.1,"y":0.2,"value":0.3},{"x":0.9,"y":0.1,"colour":[1,0,0],"label":4},{"x":0.5,"y":0.8,"orientation":[1,0,0]},{"x":0.3,"y":0.6}]"#
+            .to_vec(),
+    ));
     seeds
 }
 
@@ -459,6 +474,12 @@ fn scene_using(kind: Kind, file: &str) -> String {
                 [camera]\nfov = 50\neye = [0.5, 0.5, 3]\ntarget = [0.5, 0.5, 0]\n";
     match kind {
         Kind::Obj => format!("{head}[[shapes]]\ntype = \"obj\"\nfilename = \"{file}\"\nemission = 1\n"),
+        Kind::PupsPoints => format!(
+            "{head}[textures.p]\ntype = \"pups\"\npoints_file = \"{file}\"\ntileable = true\nlabels = true\n\
+             [materials.m]\ntype = \"diffuse\"\nreflectance = \"p\"\n\
+             [[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\n\
+             [environment]\ntype = \"constant\"\nradiance = 1\n"
+        ),
         Kind::QuadObj => format!(
             "{head}[textures.t]\ntype = \"quad_tiles\"\nfilename = \"{}\"\nfilter = \"ewa\"\n\
              [materials.m]\ntype = \"diffuse\"\nreflectance = \"t\"\n\
@@ -529,6 +550,10 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     let bytes = match seed.kind {
         Kind::Glb => mutate_glb(rng, &seed.bytes),
         Kind::Gltf | Kind::Cuts => mutate_json(rng, &String::from_utf8_lossy(&seed.bytes)),
+        Kind::PupsPoints if seed.name.extension().is_some_and(|e| e == "json") => {
+            mutate_json(rng, &String::from_utf8_lossy(&seed.bytes))
+        }
+        Kind::PupsPoints => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
         Kind::Scene | Kind::Obj | Kind::QuadObj => mutate_text(rng, &String::from_utf8_lossy(&seed.bytes)),
         Kind::Image => {
             let mut b = seed.bytes.clone();
@@ -567,6 +592,10 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
                 mesh.write_obj(&dir.join("mapped.obj"), "tiles.png", Some(&mesh.vertex_normals()))
                     .map_err(|e| format!("writing the mapped mesh: {e}"))?;
             }
+        }
+    } else if seed.kind == Kind::PupsPoints {
+        if let Ok(points) = tessera::pups::read_points(&file) {
+            let _ = tessera::pups::PupsTexture::from_points(points, false, 1.0, 0.5, false);
         }
     } else if seed.kind == Kind::Cuts {
         let _ = tessera::texture::tiling_blending::cuts_from_json(&String::from_utf8_lossy(&bytes));
@@ -634,7 +663,7 @@ fn fuzz_loaders_with_mutated_inputs() {
         }
     }
     worker.join().unwrap();
-    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image", "cuts", "quad OBJ"]
+    let per_kind: Vec<String> = ["scene", "OBJ", "glTF", "GLB", "image", "cuts", "quad OBJ", "PUPs points"]
         .iter()
         .enumerate()
         .map(|(k, name)| format!("{name} {}/{}", RENDERED[k].load(Ordering::Relaxed), CASES[k].load(Ordering::Relaxed)))

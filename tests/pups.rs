@@ -131,3 +131,59 @@ fn pups_textures_feed_materials_and_tiling_and_blending() {
     assert_eq!(image.non_finite_count(), 0);
     assert!(image.channel_means().iter().all(|&m| m > 0.01));
 }
+
+/// Points files: read by the command line and by scenes; an empty file, a NaN coordinate,
+/// collinear points and a single point are errors naming the file, never a panic.
+#[test]
+fn points_files_render_and_bad_ones_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let good =
+        write("good.csv", "x,y,r,g,b,label\n0.2,0.2,1,0,0,0\n0.8,0.3,0,1,0,1\n0.5,0.8,0,0,1,2\n0.4,0.5,1,1,0,0\n");
+    let out = dir.path().join("good.png");
+    let run = |args: &[&std::ffi::OsStr]| Command::new(env!("CARGO_BIN_EXE_tessera")).args(args).output().unwrap();
+    let ok = run(&[
+        "pups".as_ref(),
+        "--points-file".as_ref(),
+        good.as_os_str(),
+        "--labels".as_ref(),
+        "--res".as_ref(),
+        "32".as_ref(),
+        "32".as_ref(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let image = read_bitmap(&out, ColorSpace::Linear).unwrap();
+    // Cells: the corners show the colours of the points nearest them.
+    assert!(image.pixel(0, 31).x > 0.9 && image.pixel(0, 31).y < 0.1, "{}", image.pixel(0, 31));
+    for (name, text, needle) in [
+        ("empty.csv", "", "empty"),
+        ("nan.csv", "x,y\n0,0\nNaN,0.5\n1,1\n", "not finite"),
+        ("line.csv", "x,y\n0,0\n0.5,0.5\n1,1\n", "one line"),
+        ("one.json", r#"[{"x":0.5,"y":0.5}]"#, "at least three"),
+    ] {
+        let path = write(name, text);
+        let bad = run(&["pups".as_ref(), "--points-file".as_ref(), path.as_os_str(), "-o".as_ref(), out.as_os_str()]);
+        assert_eq!(bad.status.code(), Some(1), "{name}");
+        let stderr = String::from_utf8_lossy(&bad.stderr);
+        assert!(stderr.contains(name) && stderr.contains(needle) && !stderr.contains("panicked"), "{name}: {stderr}");
+    }
+    // In a scene, beside a preset's keys it does not take.
+    let toml = |extra: &str| {
+        format!(
+            "[render]\nwidth = 4\nheight = 4\nspp = 1\n[camera]\nfov = 30\neye = [0, 0, 4]\ntarget = [0, 0, 0]\n\
+             [textures.p]\ntype = \"pups\"\npoints_file = \"{}\"\n{extra}\n[materials.m]\ntype = \"diffuse\"\n\
+             reflectance = \"p\"\n[[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\n",
+            good.display()
+        )
+    };
+    let load = |text: String| tessera::scene::load_scene_str(&text, &dir.path().join("s.toml"), &Default::default());
+    assert!(load(toml("labels = true")).is_ok());
+    let msg = load(toml("seed = 3")).err().unwrap().to_string();
+    assert!(msg.contains("apply to presets"), "{msg}");
+}

@@ -12,8 +12,16 @@ use tessera::texture::{BakeFootprint, Texture, bake_rect};
 /// `tessera pups` arguments.
 #[derive(clap::Args)]
 pub struct PupsArgs {
-    /// The preset: a texture of paper 002 Sec. 3.
-    preset: Preset,
+    /// The preset: a texture of paper 002 Sec. 3 (or give --points-file).
+    #[arg(required_unless_present = "points_file")]
+    preset: Option<Preset>,
+    /// Control points from a CSV or JSON file instead of a preset (docs/scene-format.md).
+    #[arg(long, conflicts_with_all = ["preset", "reference"])]
+    points_file: Option<PathBuf>,
+    /// With --points-file: each label's colour where its points weigh most (cells), instead of
+    /// the blended values.
+    #[arg(long, requires = "points_file")]
+    labels: bool,
     /// About how many control points the base layer has over the unit square.
     #[arg(long, default_value_t = 700)]
     points: u32,
@@ -55,7 +63,18 @@ pub fn run(args: PupsArgs) -> Result<()> {
         reference,
     };
     let start = Instant::now();
-    let texture = PupsTexture::preset(args.preset, &params).map_err(|msg| Error::param(args.preset.name(), msg))?;
+    let (texture, what) = match (args.preset, &args.points_file) {
+        (Some(preset), _) => {
+            (PupsTexture::preset(preset, &params).map_err(|msg| Error::param(preset.name(), msg))?, preset.name())
+        }
+        (None, Some(file)) => {
+            let points = tessera::pups::read_points(file)?;
+            let texture = PupsTexture::from_points(points, args.tileable, args.axis_scale, args.epsilon, args.labels)
+                .map_err(|msg| Error::scene(file, msg))?;
+            (texture, file.display().to_string())
+        }
+        (None, None) => unreachable!("clap requires a preset or a points file"),
+    };
     let built = start.elapsed().as_secs_f64();
     let points = texture.point_count();
     let (w, h) = (args.res[0] as usize, args.res[1] as usize);
@@ -64,7 +83,7 @@ pub fn run(args: PupsArgs) -> Result<()> {
     eprintln!(
         "{}: {} ({points} control points), {w} x {h}, built in {built:.3} s, evaluated in {:.3} s",
         args.output.display(),
-        args.preset.name(),
+        what,
         start.elapsed().as_secs_f64() - built
     );
     Ok(())

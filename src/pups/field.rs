@@ -142,6 +142,13 @@ impl PupsField {
             let mut poly = vec![lo, Vec2::new(hi.x, lo.y), hi, Vec2::new(lo.x, hi.y)];
             for &j in &neighbours[i] {
                 let a = centres[j as usize] - *c;
+                if !(a.length_squared() >= 1e-12 && a.length_squared().is_finite()) {
+                    return Err(format!(
+                        "control points {} and {} are closer than 1e-6 (or too far apart): their axis has no usable length",
+                        source[i] + 1,
+                        source[j as usize] + 1
+                    ));
+                }
                 let q = a / (axis_scale * a.length_squared());
                 axes.push(q);
                 poly = clip(&poly, *c, q);
@@ -423,6 +430,8 @@ mod tests {
         assert!(PupsField::new(&nan, square, 1.0, 0.0).unwrap_err().contains("non-finite"));
         let twice = points(vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::Y]);
         assert!(PupsField::new(&twice, square, 1.0, 0.0).unwrap_err().contains("distinct"));
+        let close = points(vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::new(1e-7, 0.0)]);
+        assert!(PupsField::new(&close, square, 1.0, 0.0).unwrap_err().contains("closer than"));
     }
 
     /// The normalised weights are a partition of unity (the raw sum is positive everywhere),

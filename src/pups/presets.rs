@@ -144,10 +144,33 @@ impl PupsTexture {
         Builder::new(params)?.build(preset)
     }
 
-    /// A single field read as values (a points file's texture).
-    pub fn from_field(field: PupsField, labels: Option<Vec<Vec3>>) -> Self {
-        let output = labels.map_or(Output::Value, Output::Label);
-        PupsTexture { layers: vec![Layer { field, output, amplitude: 1.0 }] }
+    /// The texture of given control points (a points file): their values blended (Eq. 3), or
+    /// with `labels` each point's label showing the colour of the label's first point, taken
+    /// by the largest weight (cells).
+    pub fn from_points(
+        mut points: ControlPoints,
+        tileable: bool,
+        axis_scale: f32,
+        epsilon: f32,
+        labels: bool,
+    ) -> Result<Self, String> {
+        let domain = if tileable { Domain::Periodic } else { Domain::Square { margin: 0.0 } };
+        let output = if labels {
+            // Labels renumbered densely in order of appearance; each shows its first point's colour.
+            let mut dense = std::collections::HashMap::new();
+            let mut palette = Vec::new();
+            for (label, value) in points.labels.iter_mut().zip(&points.values) {
+                *label = *dense.entry(*label).or_insert_with(|| {
+                    palette.push(*value);
+                    palette.len() as u32 - 1
+                });
+            }
+            Output::Label(palette)
+        } else {
+            Output::Value
+        };
+        let field = PupsField::new(&points, domain, axis_scale, epsilon)?;
+        Ok(PupsTexture { layers: vec![Layer { field, output, amplitude: 1.0 }] })
     }
 }
 

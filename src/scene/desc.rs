@@ -128,13 +128,18 @@ pub enum TextureDesc {
     },
     /// Tiling and blending of an exemplar, optionally deformed (paper 000 Sec. 3).
     TilingBlending(Box<TilingBlendingDesc>),
-    /// A partition-of-unity parametric texture (paper 002): a named preset of Sec. 3,
-    /// evaluated at every lookup.
+    /// A partition-of-unity parametric texture (paper 002): a named preset of Sec. 3, or
+    /// control points from a file, evaluated at every lookup.
     Pups {
         /// The preset (`noise`, `octaves`, `turbulence`, `cells`, `clustered-cells`,
         /// `multiscale-cells`, `cow`, `space-giraffe`, `reference-labels`, `iterative`,
-        /// `progressive-cow`, `progressive-giraffe`, `label-ramp`).
-        preset: crate::pups::Preset,
+        /// `progressive-cow`, `progressive-giraffe`, `label-ramp`); or `points_file`.
+        preset: Option<crate::pups::Preset>,
+        /// Control points from a CSV or JSON file instead of a preset.
+        points_file: Option<String>,
+        /// With `points_file`: show each label's colour where its points weigh most (cells)
+        /// instead of blending the values (default false).
+        labels: Option<bool>,
         /// About how many control points its base layer has over the unit square (default 700).
         points: Option<u32>,
         /// Seed of the points and their attributes (default 0).

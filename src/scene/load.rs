@@ -19,7 +19,7 @@ use crate::limits;
 use crate::material::{
     ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId, named_conductor, named_ior,
 };
-use crate::pups::{PresetParams, PupsTexture};
+use crate::pups::{PresetParams, PupsTexture, read_points};
 use crate::texture::tiling_blending::{
     Blend, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
 };
@@ -353,7 +353,18 @@ impl<'a> Loader<'a> {
                 })
             }
             TextureDesc::TilingBlending(d) => self.tiling_blending(name, d, role)?,
-            TextureDesc::Pups { preset, points, seed, tileable, epsilon, axis_scale, reference, scale } => {
+            TextureDesc::Pups {
+                preset,
+                points_file,
+                labels,
+                points,
+                seed,
+                tileable,
+                epsilon,
+                axis_scale,
+                reference,
+                scale,
+            } => {
                 let defaults = PresetParams::default();
                 let reference = match reference {
                     Some(file) => Some(
@@ -373,8 +384,28 @@ impl<'a> Loader<'a> {
                 if !scale.iter().all(|v| v.is_finite()) {
                     return Err(self.error(format!("textures.{name}: scale must be finite")));
                 }
-                let texture = PupsTexture::preset(*preset, &params)
-                    .map_err(|msg| self.error(format!("textures.{name}: {msg}")))?;
+                let texture = match (preset, points_file) {
+                    (Some(_), None) if labels.is_some() => Err("labels applies to a points_file".into()),
+                    (Some(preset), None) => PupsTexture::preset(*preset, &params),
+                    (None, Some(_)) if points.is_some() || seed.is_some() || params.reference.is_some() => {
+                        Err("points, seed and reference apply to presets, not to a points_file".into())
+                    }
+                    (None, Some(file)) => {
+                        let file = self.resolve_path(file);
+                        let control =
+                            read_points(&file).map_err(|e| e.in_scene(self.path, format!("textures.{name}")))?;
+                        PupsTexture::from_points(
+                            control,
+                            params.tileable,
+                            params.axis_scale,
+                            params.epsilon,
+                            labels.unwrap_or(false),
+                        )
+                        .map_err(|msg| format!("{}: {msg}", file.display()))
+                    }
+                    _ => Err("give either a preset or a points_file".into()),
+                }
+                .map_err(|msg| self.error(format!("textures.{name}: {msg}")))?;
                 Texture::Pups(Arc::new(texture), Vec2::from(*scale))
             }
             TextureDesc::QuadTiles { filename, conditions, filter, .. } => {
