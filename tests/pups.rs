@@ -187,3 +187,24 @@ fn points_files_render_and_bad_ones_are_named() {
     let msg = load(toml("seed = 3")).err().unwrap().to_string();
     assert!(msg.contains("apply to presets"), "{msg}");
 }
+
+/// Cells (sharp borders) smaller than a pixel on a receding plane (what filtering is for): at
+/// 8 spp the footprint supersampling is closer to
+/// the converged unfiltered render than point lookups are, keeps the mean, and converges to it
+/// as spp grows (the footprint shrinks).
+#[test]
+fn supersampled_lookups_converge_to_the_unfiltered_render() {
+    let render_with = |filter: &str, spp: u32| {
+        let toml = format!(
+            "[render]\nwidth = 32\nheight = 32\nspp = {spp}\nmax_depth = 2\n\
+             [camera]\nfov = 30\neye = [0, 1, 3]\ntarget = [0, 0, 0]\n\
+             [environment]\ntype = \"constant\"\nradiance = 1\n\
+             [textures.t]\ntype = \"pups\"\npreset = \"cells\"\npoints = 300\ntileable = true\nscale = [16, 16]\nfilter = \"{filter}\"\n\
+             [materials.m]\ntype = \"diffuse\"\nreflectance = \"t\"\n\
+             [[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\ntransform = [{{ scale = 4 }}, {{ rotate = [1, 0, 0], angle = -90 }}]\n"
+        );
+        let (_dir, scene) = common::scene(&toml, &[]);
+        tessera::integrator::render(&scene, None, &[], &|_, _| {}).radiance()
+    };
+    common::assert_filtered_renders_converge(&["supersample"], render_with);
+}

@@ -424,7 +424,11 @@ fn pups(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
     use tessera::pups::{Preset, PresetParams, PupsTexture};
     let params = PresetParams { points: 700, ..Default::default() };
     let texture = Arc::new(PupsTexture::preset(Preset::Noise, &params).map_err(|m| Error::param("bench", m))?);
-    let pups = Texture::Pups(texture.clone(), Vec2::ONE);
+    let pups = Texture::Pups(tessera::texture::PupsLookup {
+        texture: texture.clone(),
+        scale: Vec2::ONE,
+        filter: tessera::pups::PupsFilter::None,
+    });
     let mut times = Vec::new();
     for _ in 0..runs {
         let start = Instant::now();

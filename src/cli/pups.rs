@@ -6,8 +6,8 @@ use std::time::Instant;
 use tessera::error::{Error, Result};
 use tessera::image::{ColorSpace, OutputFormat, read_bitmap, write_image};
 use tessera::limits;
-use tessera::pups::{Preset, PresetParams, PupsTexture};
-use tessera::texture::{BakeFootprint, Texture, bake_rect};
+use tessera::pups::{Preset, PresetParams, PupsFilter, PupsTexture};
+use tessera::texture::{BakeFootprint, PupsLookup, Texture, bake_rect};
 
 /// `tessera pups` arguments.
 #[derive(clap::Args)]
@@ -78,7 +78,8 @@ pub fn run(args: PupsArgs) -> Result<()> {
     let built = start.elapsed().as_secs_f64();
     let points = texture.point_count();
     let (w, h) = (args.res[0] as usize, args.res[1] as usize);
-    let image = bake_rect(&Texture::Pups(Arc::new(texture), glam::Vec2::ONE), w, h, BakeFootprint::Point);
+    let lookup = PupsLookup { texture: Arc::new(texture), scale: glam::Vec2::ONE, filter: PupsFilter::None };
+    let image = bake_rect(&Texture::Pups(lookup), w, h, BakeFootprint::Point);
     write_image(&args.output, &image.without_alpha(), &[])?;
     eprintln!(
         "{}: {} ({points} control points), {w} x {h}, built in {built:.3} s, evaluated in {:.3} s",

@@ -16,4 +16,4 @@ pub mod presets;
 pub use field::{ControlPoints, PupsField};
 pub use file::read_points;
 pub use points::Domain;
-pub use presets::{Preset, PresetParams, PupsTexture};
+pub use presets::{Preset, PresetParams, PupsFilter, PupsTexture};

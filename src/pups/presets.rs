@@ -107,13 +107,51 @@ struct Layer {
     amplitude: f32,
 }
 
+/// How a PUPs texture is filtered over a lookup's footprint.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum PupsFilter {
+    /// The value at the point (the ground truth when pixels are supersampled).
+    #[default]
+    None,
+    /// The mean of k x k stratified points over the footprint's parallelogram, k from 1 to
+    /// [`MAX_TAPS`] growing with the footprint's width over the finest point spacing.
+    Supersample,
+}
+
+/// Most taps per side of the footprint supersampling.
+pub const MAX_TAPS: usize = 4;
+
 /// A PUPs texture: the sum of its layers' amplitudes times their outputs.
 #[derive(Clone, Debug)]
 pub struct PupsTexture {
     layers: Vec<Layer>,
+    /// The finest layer's typical point spacing (the size of its features).
+    feature: f32,
 }
 
 impl PupsTexture {
+    /// The value over the footprint `duv_dx`, `duv_dy` around `uv` with `filter`.
+    pub fn eval_filtered(&self, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2, filter: PupsFilter) -> Vec4 {
+        let width = duv_dx.abs().max(duv_dy.abs()).max_element();
+        let taps = match filter {
+            PupsFilter::None => 1,
+            // Two taps per feature across the footprint.
+            PupsFilter::Supersample => ((2.0 * width / self.feature).ceil() as usize).clamp(1, MAX_TAPS),
+        };
+        if taps == 1 {
+            return self.eval(uv);
+        }
+        let mut sum = Vec4::ZERO;
+        for j in 0..taps {
+            for i in 0..taps {
+                let (s, t) = ((i as f32 + 0.5) / taps as f32 - 0.5, (j as f32 + 0.5) / taps as f32 - 0.5);
+                sum += self.eval(uv + duv_dx * s + duv_dy * t);
+            }
+        }
+        sum / (taps * taps) as f32
+    }
+
     /// RGBA value at `uv` (alpha 1).
     pub fn eval(&self, uv: Vec2) -> Vec4 {
         let mut sum = Vec3::ZERO;
@@ -170,7 +208,12 @@ impl PupsTexture {
             Output::Value
         };
         let field = PupsField::new(&points, domain, axis_scale, epsilon)?;
-        Ok(PupsTexture { layers: vec![Layer { field, output, amplitude: 1.0 }] })
+        Ok(PupsTexture::new(vec![Layer { field, output, amplitude: 1.0 }]))
+    }
+
+    fn new(layers: Vec<Layer>) -> Self {
+        let finest = layers.iter().map(|l| l.field.point_count()).max().unwrap_or(1);
+        PupsTexture { layers, feature: (1.0 / finest.max(1) as f32).sqrt() }
     }
 }
 
@@ -413,7 +456,7 @@ impl<'a> Builder<'a> {
                 vec![Layer { field, output: Output::Value, amplitude: 1.0 }]
             }
         };
-        Ok(PupsTexture { layers })
+        Ok(PupsTexture::new(layers))
     }
 }
 

@@ -155,6 +155,10 @@ pub enum TextureDesc {
         /// Multiplier of the texture coordinates (default [1, 1]; a tileable texture repeats).
         #[serde(default = "unit_scale")]
         scale: [f32; 2],
+        /// `none` (the value at the point, default) or `supersample` (the mean over the
+        /// lookup's footprint).
+        #[serde(default)]
+        filter: crate::pups::PupsFilter,
     },
     /// A tile image written by `tessera tiles synth` (paper 001), for a quad mesh whose
     /// texture coordinates `tessera tiles map` assigned: each lookup filters one tile only.

@@ -23,7 +23,7 @@ use crate::pups::{PresetParams, PupsTexture, read_points};
 use crate::texture::tiling_blending::{
     Blend, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
 };
-use crate::texture::{ImageTexture, MipMap, QuadTilesTexture, Texture, TilingBlending};
+use crate::texture::{ImageTexture, MipMap, PupsLookup, QuadTilesTexture, Texture, TilingBlending};
 use glam::{Mat2, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::f32::consts::PI;
@@ -364,6 +364,7 @@ impl<'a> Loader<'a> {
                 axis_scale,
                 reference,
                 scale,
+                filter,
             } => {
                 let defaults = PresetParams::default();
                 let reference = match reference {
@@ -406,7 +407,7 @@ impl<'a> Loader<'a> {
                     _ => Err("give either a preset or a points_file".into()),
                 }
                 .map_err(|msg| self.error(format!("textures.{name}: {msg}")))?;
-                Texture::Pups(Arc::new(texture), Vec2::from(*scale))
+                Texture::Pups(PupsLookup { texture: Arc::new(texture), scale: Vec2::from(*scale), filter: *filter })
             }
             TextureDesc::QuadTiles { filename, conditions, filter, .. } => {
                 let file = self.resolve_path(filename);

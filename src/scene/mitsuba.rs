@@ -99,7 +99,7 @@ impl Exporter<'_> {
                 }
                 (tex.scale, tex.offset)
             }
-            Texture::TilingBlending(_) | Texture::QuadTiles(_) | Texture::Pups(..) => {
+            Texture::TilingBlending(_) | Texture::QuadTiles(_) | Texture::Pups(_) => {
                 self.out.warnings.push(format!(
                     "texture {} is procedural: baked over the UV square at {res}x{res} (lookups outside [0, 1] repeat the bake)",
                     id.0,

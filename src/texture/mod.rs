@@ -108,8 +108,27 @@ pub enum Texture {
     TilingBlending(TilingBlending),
     /// A tile image of paper 001 read tile by tile (a quad mesh mapped by `tessera tiles map`).
     QuadTiles(QuadTilesTexture),
-    /// A partition-of-unity parametric texture (paper 002), its texture coordinates scaled.
-    Pups(Arc<crate::pups::PupsTexture>, Vec2),
+    /// A partition-of-unity parametric texture (paper 002).
+    Pups(PupsLookup),
+}
+
+/// A PUPs texture as a scene reads it: texture coordinates scaled, the footprint filtered.
+#[derive(Clone, Debug)]
+pub struct PupsLookup {
+    /// The texture.
+    pub texture: Arc<crate::pups::PupsTexture>,
+    /// Multiplier of the texture coordinates.
+    pub scale: Vec2,
+    /// How the footprint is filtered.
+    pub filter: crate::pups::PupsFilter,
+}
+
+impl PupsLookup {
+    /// Filtered value at the lookup.
+    pub fn eval(&self, ctx: &TexCtx) -> Vec4 {
+        let s = self.scale;
+        self.texture.eval_filtered(ctx.uv * s, ctx.duv_dx * s, ctx.duv_dy * s, self.filter)
+    }
 }
 
 impl Texture {
@@ -120,7 +139,7 @@ impl Texture {
             Texture::Image(t) => t.eval(ctx),
             Texture::TilingBlending(t) => t.eval(ctx),
             Texture::QuadTiles(t) => t.eval(ctx),
-            Texture::Pups(t, scale) => t.eval(ctx.uv * *scale),
+            Texture::Pups(t) => t.eval(ctx),
         }
     }
 
@@ -149,7 +168,7 @@ impl Texture {
             Texture::Image(t) => t.filter != Filter::None,
             Texture::TilingBlending(t) => t.uses_footprint(),
             Texture::QuadTiles(t) => t.filter != Filter::None,
-            Texture::Pups(..) => false,
+            Texture::Pups(t) => t.filter != crate::pups::PupsFilter::None,
         }
     }
 
@@ -159,7 +178,7 @@ impl Texture {
             Texture::Image(t) => t.mipmap.memory_bytes(),
             Texture::TilingBlending(t) => t.memory_bytes(),
             Texture::QuadTiles(t) => t.memory_bytes(),
-            Texture::Pups(t, _) => t.memory_bytes(),
+            Texture::Pups(t) => t.texture.memory_bytes(),
         }
     }
 }
