@@ -208,3 +208,17 @@ fn supersampled_lookups_converge_to_the_unfiltered_render() {
     };
     common::assert_filtered_renders_converge(&["supersample"], render_with);
 }
+
+/// A density image sets the spacing: white (half the base spacing) holds about 16 times the
+/// points of black (twice the base spacing).
+#[test]
+fn a_density_image_sets_the_point_density() {
+    let count = |grey: f32| {
+        let mut image = tessera::image::Bitmap::new(4, 4, 1);
+        image.data.fill(grey);
+        let params = PresetParams { points: 400, tileable: true, density: Some(image), ..Default::default() };
+        PupsTexture::preset(Preset::Noise, &params).unwrap().point_count() as f32
+    };
+    let ratio = count(1.0) / count(0.0);
+    assert!((10.0..25.0).contains(&ratio), "white over black: {ratio}");
+}

@@ -45,6 +45,10 @@ pub struct PupsArgs {
     /// on a ramp).
     #[arg(long)]
     reference: Option<PathBuf>,
+    /// A grey density image: the points' spacing from twice the base (black) to half (white),
+    /// for presets without their own density ramp.
+    #[arg(long, conflicts_with = "points_file")]
+    density: Option<PathBuf>,
     /// Output image (.png or .exr).
     #[arg(short, long)]
     output: PathBuf,
@@ -61,6 +65,7 @@ pub fn run(args: PupsArgs) -> Result<()> {
         epsilon: args.epsilon,
         axis_scale: args.axis_scale,
         reference,
+        density: args.density.as_deref().map(|p| read_bitmap(p, ColorSpace::Linear)).transpose()?,
     };
     let start = Instant::now();
     let (texture, what) = match (args.preset, &args.points_file) {

@@ -80,11 +80,22 @@ pub struct PresetParams {
     /// A grey reference image for the label presets of Fig. 13-14 (a built-in disc and ramp
     /// when None).
     pub reference: Option<Bitmap>,
+    /// A grey density image: the base points' spacing goes from twice the base where it is
+    /// black to half where it is white (presets without their own density ramp).
+    pub density: Option<Bitmap>,
 }
 
 impl Default for PresetParams {
     fn default() -> Self {
-        PresetParams { points: 700, seed: 0, tileable: false, epsilon: 0.5, axis_scale: 1.0, reference: None }
+        PresetParams {
+            points: 700,
+            seed: 0,
+            tileable: false,
+            epsilon: 0.5,
+            axis_scale: 1.0,
+            reference: None,
+            density: None,
+        }
     }
 }
 
@@ -245,13 +256,21 @@ impl<'a> Builder<'a> {
     fn points(&mut self, scale: f32, ramp: Option<(f32, f32)>) -> Result<Vec<Vec2>, String> {
         let seed = (self.sampler.next_1d() * 16_777_216.0) as u64;
         let base = self.spacing * scale;
+        // A density image, where the preset has no ramp of its own: bright is dense, the
+        // spacing from 2 (black) to 0.5 (white) times the base.
+        let image = if ramp.is_none() { self.params.density.as_ref() } else { None };
+        let ramp = ramp.or(image.map(|_| (2.0, 0.5)));
         let domain = match self.domain {
             Domain::Square { .. } => Domain::Square { margin: 3.0 * base * ramp.map_or(1.0, |r| r.0) },
             periodic => periodic,
         };
-        match ramp {
-            None => poisson_disk(domain, base, base, &|_| base, seed),
-            Some((sparse, dense)) => {
+        match (ramp, image) {
+            (None, _) => poisson_disk(domain, base, base, &|_| base, seed),
+            (Some((sparse, dense)), Some(image)) => {
+                let spacing = |p: Vec2| base * (sparse + (dense - sparse) * intensity(image, p));
+                poisson_disk(domain, base * dense, base * sparse, &spacing, seed)
+            }
+            (Some((sparse, dense)), None) => {
                 let spacing = |p: Vec2| base * (sparse + (dense - sparse) * p.x.clamp(0.0, 1.0));
                 poisson_disk(domain, base * dense.min(sparse), base * dense.max(sparse), &spacing, seed)
             }
@@ -312,15 +331,10 @@ impl<'a> Builder<'a> {
     /// The reference image's intensity at `p` (the unit square, v up), or the built-in one: a
     /// disc on a ramp.
     fn reference(&self, p: Vec2) -> f32 {
-        let p = p.clamp(Vec2::ZERO, Vec2::ONE);
         match &self.params.reference {
-            Some(image) => {
-                let x = ((p.x * image.width as f32) as usize).min(image.width - 1);
-                let y = (((1.0 - p.y) * image.height as f32) as usize).min(image.height - 1);
-                let c = image.pixel(x, y);
-                (c.x + c.y + c.z) / 3.0
-            }
+            Some(image) => intensity(image, p),
             None => {
+                let p = p.clamp(Vec2::ZERO, Vec2::ONE);
                 let disc = if p.distance(Vec2::new(0.45, 0.55)) < 0.28 { 1.0 } else { 0.0 };
                 (disc * 0.85 + p.x * 0.3).min(1.0)
             }
@@ -458,6 +472,15 @@ impl<'a> Builder<'a> {
         };
         Ok(PupsTexture::new(layers))
     }
+}
+
+/// The grey intensity of `image` at `p` (the unit square, v up; nearest pixel, clamped).
+fn intensity(image: &Bitmap, p: Vec2) -> f32 {
+    let p = p.clamp(Vec2::ZERO, Vec2::ONE);
+    let x = ((p.x * image.width as f32) as usize).min(image.width - 1);
+    let y = (((1.0 - p.y) * image.height as f32) as usize).min(image.height - 1);
+    let c = image.pixel(x, y);
+    ((c.x + c.y + c.z) / 3.0).clamp(0.0, 1.0)
 }
 
 /// Groups of three or four neighbouring points (Fig. 9b): each point not yet grouped starts a

@@ -152,6 +152,9 @@ pub enum TextureDesc {
         axis_scale: Option<f32>,
         /// A grey reference image for `reference-labels` and `iterative`.
         reference: Option<String>,
+        /// A grey density image: the points' spacing from twice the base (black) to half
+        /// (white), for presets without their own density ramp.
+        density: Option<String>,
         /// Multiplier of the texture coordinates (default [1, 1]; a tileable texture repeats).
         #[serde(default = "unit_scale")]
         scale: [f32; 2],

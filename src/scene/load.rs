@@ -363,17 +363,19 @@ impl<'a> Loader<'a> {
                 epsilon,
                 axis_scale,
                 reference,
+                density,
                 scale,
                 filter,
             } => {
                 let defaults = PresetParams::default();
-                let reference = match reference {
-                    Some(file) => Some(
-                        read_bitmap(&self.resolve_path(file), ColorSpace::Linear)
-                            .map_err(|e| e.in_scene(self.path, format!("textures.{name}.reference")))?,
-                    ),
-                    None => None,
+                let grey_image = |file: &Option<String>, key: &str| match file {
+                    Some(file) => read_bitmap(&self.resolve_path(file), ColorSpace::Linear)
+                        .map(Some)
+                        .map_err(|e| e.in_scene(self.path, format!("textures.{name}.{key}"))),
+                    None => Ok(None),
                 };
+                let reference = grey_image(reference, "reference")?;
+                let density = grey_image(density, "density")?;
                 let params = PresetParams {
                     points: points.unwrap_or(defaults.points),
                     seed: seed.unwrap_or(defaults.seed),
@@ -381,6 +383,7 @@ impl<'a> Loader<'a> {
                     epsilon: epsilon.unwrap_or(defaults.epsilon),
                     axis_scale: axis_scale.unwrap_or(defaults.axis_scale),
                     reference,
+                    density,
                 };
                 if !scale.iter().all(|v| v.is_finite()) {
                     return Err(self.error(format!("textures.{name}: scale must be finite")));
@@ -388,8 +391,13 @@ impl<'a> Loader<'a> {
                 let texture = match (preset, points_file) {
                     (Some(_), None) if labels.is_some() => Err("labels applies to a points_file".into()),
                     (Some(preset), None) => PupsTexture::preset(*preset, &params),
-                    (None, Some(_)) if points.is_some() || seed.is_some() || params.reference.is_some() => {
-                        Err("points, seed and reference apply to presets, not to a points_file".into())
+                    (None, Some(_))
+                        if points.is_some()
+                            || seed.is_some()
+                            || params.reference.is_some()
+                            || params.density.is_some() =>
+                    {
+                        Err("points, seed, reference and density apply to presets, not to a points_file".into())
                     }
                     (None, Some(file)) => {
                         let file = self.resolve_path(file);
