@@ -228,6 +228,9 @@ impl PupsTexture {
     }
 }
 
+/// Fewest points a preset is asked for: a Poisson disk draw of fewer may leave fewer than three.
+pub const MIN_POINTS: u32 = 16;
+
 /// Builds presets: draws points, assigns attributes, makes fields.
 struct Builder<'a> {
     params: &'a PresetParams,
@@ -243,8 +246,8 @@ const GIRAFFE: [Vec3; 2] = [Vec3::new(0.85, 0.75, 0.55), Vec3::new(0.35, 0.17, 0
 
 impl<'a> Builder<'a> {
     fn new(params: &'a PresetParams) -> Result<Self, String> {
-        if !(3..=super::points::MAX_POINTS as u32).contains(&params.points) {
-            return Err(format!("{} points: give 3 to {}", params.points, super::points::MAX_POINTS));
+        if !(MIN_POINTS..=super::points::MAX_POINTS as u32).contains(&params.points) {
+            return Err(format!("{} points: give {MIN_POINTS} to {}", params.points, super::points::MAX_POINTS));
         }
         let spacing = spacing_for_count(params.points);
         let domain = if params.tileable { Domain::Periodic } else { Domain::Square { margin: 3.0 * spacing } };
@@ -275,6 +278,11 @@ impl<'a> Builder<'a> {
                 poisson_disk(domain, base * dense.min(sparse), base * dense.max(sparse), &spacing, seed)
             }
         }
+    }
+
+    /// A spacing `scale` times the base, capped so that the layer keeps [`MIN_POINTS`] points.
+    fn coarser(&self, scale: f32) -> f32 {
+        scale.min((self.params.points as f32 / MIN_POINTS as f32).sqrt())
     }
 
     fn random_orientations(&mut self, n: usize) -> Vec<Vec3> {
@@ -349,7 +357,8 @@ impl<'a> Builder<'a> {
         let nearest: Vec<f32> = centres
             .iter()
             .map(|c| {
-                centres.iter().filter(|o| *o != c).map(|o| self.domain.offset(*c, *o).length()).fold(f32::MAX, f32::min)
+                // At most 1: on the torus a lone centre's nearest neighbour is its own image.
+                centres.iter().filter(|o| *o != c).map(|o| self.domain.offset(*c, *o).length()).fold(1.0, f32::min)
             })
             .collect();
         let mut positions = Vec::new();
@@ -363,8 +372,12 @@ impl<'a> Builder<'a> {
             for k in 0..n {
                 let angle = std::f32::consts::TAU * (k as f32 + phase) / n as f32;
                 let dir = Vec2::new(libm::cosf(angle), libm::sinf(angle));
-                let (a, b) = (self.sampler.next_1d() * r, self.sampler.next_1d() * r);
-                let (inner, outer) = (a.min(b).max(0.15 * r), a.max(b).max(0.3 * r));
+                // Two random radii in [0, r], the smaller for the spot point; kept off the centre
+                // (0.15 r) and apart (the outer at least a tenth of the way from the inner to r),
+                // so that no two points meet.
+                let (a, b) = (self.sampler.next_1d(), self.sampler.next_1d());
+                let inner = r * (0.15 + 0.7 * a.min(b));
+                let outer = inner + (r - inner) * (0.1 + 0.9 * a.max(b));
                 for (radius, label) in [(inner, 1), (outer, 0)] {
                     let p = *c + dir * radius;
                     positions.push(if self.domain == Domain::Periodic { p - p.floor() } else { p });
@@ -383,11 +396,11 @@ impl<'a> Builder<'a> {
             Preset::Octaves | Preset::Turbulence => {
                 let output = if preset == Preset::Octaves { Output::Value } else { Output::Folded };
                 // Octave i: spacing 2^(3 - i) times the base (the finest octave has the
-                // points asked for), amplitude 2^-i.
+                // points asked for, each coarser one a quarter as many, at least 16), amplitude 2^-i.
                 (0..4)
                     .map(|i| {
                         let s = 0.5f32.powi(i);
-                        self.value_layer(8.0 * s, output.clone(), s * octave_norm)
+                        self.value_layer(self.coarser(8.0 * s), output.clone(), s * octave_norm)
                     })
                     .collect::<Result<_, _>>()?
             }
@@ -396,7 +409,7 @@ impl<'a> Builder<'a> {
                 let mut layers = Vec::new();
                 for i in 0..count {
                     let s = 0.5f32.powi(i);
-                    let positions = self.points(if count == 1 { 1.0 } else { 8.0 * s }, None)?;
+                    let positions = self.points(if count == 1 { 1.0 } else { self.coarser(8.0 * s) }, None)?;
                     let palette = self.random_palette(positions.len(), preset == Preset::Cells);
                     let mut next = 0..;
                     let amplitude = if count == 1 { 1.0 } else { s * octave_norm };
