@@ -44,7 +44,8 @@ enum Command {
         /// Sampler seed (replaces the scene's).
         #[arg(long)]
         seed: Option<u64>,
-        /// Render only the pixels x0 <= x < x1, y0 <= y < y1; the image has the crop's size.
+        /// Render only the pixels x0 <= x < x1, y0 <= y < y1; the image has the crop's size (an
+        /// EXR keeps its place in the frame, for `tessera merge`).
         #[arg(long, value_name = "x0,y0,x1,y1")]
         crop: Option<String>,
         /// Auxiliary outputs to add to an EXR, comma separated.
@@ -86,6 +87,16 @@ enum Command {
         /// the smallest p-value of each pixel.
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Merge the EXR crops of one render (`render --crop`, each keeping its place in the frame)
+    /// into the full image: every pixel from exactly one crop, bit for bit.
+    Merge {
+        /// The crops (EXR).
+        #[arg(required = true)]
+        crops: Vec<PathBuf>,
+        /// The full image (EXR).
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Lay images out on a labelled grid (PNG or EXR), e.g. classical against deformed renders.
     Montage {
@@ -235,6 +246,16 @@ pub fn run() -> Result<ExitCode> {
         }
         Command::Tiles { command } => {
             tiles::run(command)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Merge { crops, output } => {
+            if OutputFormat::from_path(&output)? != OutputFormat::Exr {
+                return Err(Error::param("--output", "the merged image is written as .exr"));
+            }
+            let parts = crops.iter().map(|p| tessera::image::read_exr_image(p)).collect::<Result<Vec<_>>>()?;
+            let full = tessera::image::merge_crops(&parts).map_err(|msg| Error::param("merge", msg))?;
+            tessera::image::write_exr(&output, full.width, full.height, full.channels)?;
+            eprintln!("{} crops -> {} ({} x {})", crops.len(), output.display(), full.width, full.height);
             Ok(ExitCode::SUCCESS)
         }
         Command::Montage { images, columns, labels, output } => {
@@ -411,7 +432,10 @@ fn render_to_file(
     if !extra.is_empty() && tessera::image::OutputFormat::from_path(output)? == tessera::image::OutputFormat::Png {
         eprintln!("warning: AOVs are written to EXR outputs only");
     }
-    write_image(output, &film.radiance(), &extra)?;
+    // A crop's EXR keeps its place in the frame (the data window), for `tessera merge`.
+    let origin = crop.map_or((0, 0), |c| (c.x0 as usize, c.y0 as usize));
+    let window = tessera::image::ExrWindow { origin, full: (s.width as usize, s.height as usize) };
+    tessera::image::write_image_in(output, &film.radiance(), &extra, window)?;
     if !quiet {
         let invalid = film.invalid_sample_count();
         if invalid > 0 {

@@ -156,6 +156,36 @@ type NamedPlanes = Vec<(String, Vec<f32>)>;
 
 /// The channels of an OpenEXR file's first valid layer, by name, with its size.
 fn decode_exr(path: &Path) -> Result<(usize, usize, NamedPlanes)> {
+    let image = read_exr_image(path)?;
+    Ok((image.width, image.height, image.channels))
+}
+
+/// Where an image's pixels sit in a larger one: the OpenEXR data window's origin within the
+/// display window (a `--crop` render in its full frame).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExrWindow {
+    /// Column and row of the first pixel in the full image.
+    pub origin: (usize, usize),
+    /// Width and height of the full image.
+    pub full: (usize, usize),
+}
+
+/// All named float channels of an OpenEXR file and where they sit in its display window.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrImage {
+    /// Where the pixels sit.
+    pub window: ExrWindow,
+    /// Width of the data.
+    pub width: usize,
+    /// Height of the data.
+    pub height: usize,
+    /// Channels by name, each `width * height` values, row 0 at the top.
+    pub channels: NamedPlanes,
+}
+
+/// Read every channel of an OpenEXR file with its data window (bounded, checked like every
+/// image read).
+pub fn read_exr_image(path: &Path) -> Result<ExrImage> {
     use exr::prelude::traits::*;
     let bytes = read_bounded(path, limits::MAX_IMAGE_FILE_BYTES, "an image file")?;
     check_exr_header(path, &bytes)?;
@@ -169,11 +199,23 @@ fn decode_exr(path: &Path) -> Result<(usize, usize, NamedPlanes)> {
             .from_buffered(std::io::Cursor::new(&bytes[..]))
             .map_err(|e| Error::image(path, format!("cannot read OpenEXR: {e}")))
     })?;
+    let display = image.attributes.display_window;
     let layer = image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
     let channels =
         layer.channel_data.list.iter().map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect())).collect();
-    Ok((w, h, channels))
+    let position = layer.attributes.layer_position;
+    let (ox, oy) =
+        (position.x() as i64 - display.position.x() as i64, position.y() as i64 - display.position.y() as i64);
+    let full = (display.size.width(), display.size.height());
+    // A data window beyond the display window (overscan) is read as a whole image of its own.
+    let inside = ox >= 0 && oy >= 0 && ox as usize + w <= full.0 && oy as usize + h <= full.1;
+    let window = if inside {
+        ExrWindow { origin: (ox as usize, oy as usize), full }
+    } else {
+        ExrWindow { origin: (0, 0), full: (w, h) }
+    };
+    Ok(ExrImage { window, width: w, height: h, channels })
 }
 
 /// Interleave planes into a bitmap.
@@ -223,17 +265,33 @@ pub fn read_exr_channels(path: &Path, names: &[&str]) -> Result<Bitmap> {
 /// Write named float channels (each `width * height` values, row 0 at the top) to an OpenEXR
 /// file (32-bit float, ZIP compression).
 pub fn write_exr(path: &Path, width: usize, height: usize, channels: Vec<(String, Vec<f32>)>) -> Result<()> {
+    write_exr_window(path, ExrWindow { origin: (0, 0), full: (width, height) }, width, height, channels)
+}
+
+/// [`write_exr`] of pixels that sit at `window` in a larger image (the data window of a crop).
+pub fn write_exr_window(
+    path: &Path,
+    window: ExrWindow,
+    width: usize,
+    height: usize,
+    channels: Vec<(String, Vec<f32>)>,
+) -> Result<()> {
     use exr::prelude::traits::*;
-    use exr::prelude::{AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec};
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Image, ImageAttributes, IntegerBounds, Layer, LayerAttributes,
+        SmallVec, Vec2,
+    };
     let list: SmallVec<[AnyChannel<FlatSamples>; 4]> =
         channels.into_iter().map(|(name, values)| AnyChannel::new(name.as_str(), FlatSamples::F32(values))).collect();
+    let position = Vec2(window.origin.0 as i32, window.origin.1 as i32);
     let layer = Layer::new(
         (width, height),
-        LayerAttributes::named("tessera"),
+        LayerAttributes::named("tessera").with_position(position),
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(list),
     );
-    let image = Image::from_layer(layer);
+    let display = IntegerBounds::new((0, 0), (window.full.0, window.full.1));
+    let image = Image::new(ImageAttributes::new(display), layer);
     write_atomically(path, |tmp| {
         image.write().to_file(tmp).map_err(|e| match e {
             exr::error::Error::Io(io) => Error::io(path, io),
@@ -258,6 +316,11 @@ pub fn write_png(path: &Path, rgb: &Bitmap) -> Result<()> {
 /// Write an RGB image and optional extra bitmaps (named channel groups, EXR only) in the format
 /// of `path`'s extension. PNG keeps only the RGB image.
 pub fn write_image(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)]) -> Result<()> {
+    write_image_in(path, rgb, extra, ExrWindow { origin: (0, 0), full: (rgb.width, rgb.height) })
+}
+
+/// [`write_image`] of pixels that sit at `window` in a larger image (EXR keeps the window).
+pub fn write_image_in(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)], window: ExrWindow) -> Result<()> {
     match OutputFormat::from_path(path)? {
         OutputFormat::Png => write_png(path, rgb),
         OutputFormat::Exr => {
@@ -271,7 +334,7 @@ pub fn write_image(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)]) -> Re
             for (names, b) in extra {
                 push(names, b);
             }
-            write_exr(path, rgb.width, rgb.height, channels)
+            write_exr_window(path, window, rgb.width, rgb.height, channels)
         }
     }
 }

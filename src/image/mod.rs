@@ -6,13 +6,16 @@ mod bitmap;
 pub mod compare;
 mod film;
 mod io;
+mod merge;
 mod montage;
 mod seams;
 
 pub use bitmap::{Bitmap, ColorSpace};
 pub use film::{Aov, Film, PixelSum};
 pub use io::{
-    OutputFormat, decode_image, read_bitmap, read_bitmap_raw, read_exr_channels, write_exr, write_image, write_png,
+    ExrImage, ExrWindow, OutputFormat, decode_image, read_bitmap, read_bitmap_raw, read_exr_channels, read_exr_image,
+    write_exr, write_exr_window, write_image, write_image_in, write_png,
 };
+pub use merge::merge_crops;
 pub use montage::montage;
 pub use seams::{SeamVisibility, seam_visibility};
