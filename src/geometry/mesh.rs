@@ -57,6 +57,23 @@ pub struct TriangleMesh {
     pub indices: Vec<[u32; 3]>,
 }
 
+/// Positions joined where they are bit for bit equal: for each position the id of its distinct
+/// position, and the distinct positions in order of first appearance.
+pub fn weld_positions(positions: &[Vec3]) -> (Vec<u32>, Vec<Vec3>) {
+    let mut ids: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
+    let mut points = Vec::new();
+    let welded = positions
+        .iter()
+        .map(|p| {
+            *ids.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
+                points.push(*p);
+                (points.len() - 1) as u32
+            })
+        })
+        .collect();
+    (welded, points)
+}
+
 /// What [`TriangleMesh::validate`] removed or found.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MeshCleanup {
@@ -69,19 +86,7 @@ impl TriangleMesh {
     /// distinct positions. Loaders split vertices at UV seams and normal creases; welding joins
     /// the surface back (geodesic distances, UV cuts).
     pub fn welded_vertices(&self) -> (Vec<u32>, Vec<Vec3>) {
-        let mut ids: std::collections::HashMap<[u32; 3], u32> = std::collections::HashMap::new();
-        let mut points = Vec::new();
-        let welded = self
-            .positions
-            .iter()
-            .map(|p| {
-                *ids.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
-                    points.push(*p);
-                    (points.len() - 1) as u32
-                })
-            })
-            .collect();
-        (welded, points)
+        weld_positions(&self.positions)
     }
 
     /// Number of triangles.

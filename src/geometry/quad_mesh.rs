@@ -164,22 +164,12 @@ pub fn load_quad_obj(path: &Path) -> Result<QuadMesh> {
             .map_err(|e| Error::mesh(path, format!("malformed OBJ: {e}")))
     })?;
     let lines = face_lines(&bytes);
-    let mut ids: std::collections::HashMap<[u32; 3], u32> = Default::default();
     let mut positions = Vec::new();
-    let mut quads = Vec::new();
+    let mut quads: Vec<[u32; 4]> = Vec::new();
     for model in &models {
         let m = &model.mesh;
-        let welded: Vec<u32> = m
-            .positions
-            .chunks_exact(3)
-            .map(|c| {
-                let p = Vec3::new(c[0], c[1], c[2]);
-                *ids.entry(p.to_array().map(f32::to_bits)).or_insert_with(|| {
-                    positions.push(p);
-                    (positions.len() - 1) as u32
-                })
-            })
-            .collect();
+        let base = positions.len() as u32;
+        positions.extend(m.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         // tobj leaves the arities empty when every face is a triangle.
         let arities: Vec<u32> =
             if m.face_arities.is_empty() { vec![3; m.indices.len() / 3] } else { m.face_arities.clone() };
@@ -195,7 +185,10 @@ pub fn load_quad_obj(path: &Path) -> Result<QuadMesh> {
                     format!("face {}{at} has {arity} corners: tessera tiles needs a mesh of quads only", f + 1),
                 ));
             }
-            quads.push(std::array::from_fn(|k| welded[corners[k] as usize]));
+            if corners.iter().any(|&c| c as usize >= m.positions.len() / 3) {
+                return Err(Error::mesh(path, format!("face {} names a vertex that does not exist", quads.len() + 1)));
+            }
+            quads.push(std::array::from_fn(|k| base + corners[k]));
             if quads.len() as u64 > limits::MAX_TRIANGLES {
                 return Err(Error::mesh(path, format!("more than {} quads", limits::MAX_TRIANGLES)));
             }
@@ -203,6 +196,10 @@ pub fn load_quad_obj(path: &Path) -> Result<QuadMesh> {
     }
     if quads.is_empty() {
         return Err(Error::mesh(path, "no faces"));
+    }
+    let (welded, positions) = super::mesh::weld_positions(&positions);
+    for q in &mut quads {
+        *q = q.map(|v| welded[v as usize]);
     }
     let mut mesh = QuadMesh::new(positions, quads).map_err(|msg| Error::mesh(path, msg))?;
     if lines.len() == mesh.quads.len() {

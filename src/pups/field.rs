@@ -200,6 +200,14 @@ impl PupsField {
         }
     }
 
+    /// The lookup point in the square and the centres the grid lists around it.
+    fn candidates(&self, u: Vec2) -> (Vec2, &[u32]) {
+        let g = self.in_square(u);
+        let cell = |t: f32| ((t * self.cells as f32) as usize).min(self.cells - 1);
+        let c = cell(g.y) * self.cells + cell(g.x);
+        (g, &self.cell_centres[self.cell_start[c] as usize..self.cell_start[c + 1] as usize])
+    }
+
     /// Eq. 2 and 4: the weight of centre `i` at `u` (unwrapped).
     #[inline]
     fn weight(&self, i: usize, u: Vec2) -> f32 {
@@ -215,9 +223,11 @@ impl PupsField {
             }
         }
         let v = self.orientations[self.source[i] as usize];
-        let length = d.length();
-        if self.epsilon > 0.0 && v != Vec2::ZERO && length > 0.0 {
-            w = shifted_weight(w, self.epsilon * d.dot(v) / length);
+        if self.epsilon > 0.0 && v != Vec2::ZERO {
+            let length = d.length();
+            if length > 0.0 {
+                w = shifted_weight(w, self.epsilon * d.dot(v) / length);
+            }
         }
         w
     }
@@ -225,11 +235,9 @@ impl PupsField {
     /// Call `f(control point, weight)` for every centre with a weight at `u`, in a fixed order.
     /// `u` is taken as it is (periodic fields see copies beyond the square).
     pub fn for_each_weight(&self, u: Vec2, mut f: impl FnMut(usize, f32)) {
-        let g = self.in_square(u);
-        let cell = |t: f32| ((t * self.cells as f32) as usize).min(self.cells - 1);
-        let c = cell(g.y) * self.cells + cell(g.x);
+        let (g, candidates) = self.candidates(u);
         // Evaluate at the wrapped point: the grid lists the centres around it.
-        for &i in &self.cell_centres[self.cell_start[c] as usize..self.cell_start[c + 1] as usize] {
+        for &i in candidates {
             let w = self.weight(i as usize, g);
             if w > 0.0 {
                 f(self.source[i as usize] as usize, w);
@@ -269,10 +277,8 @@ impl PupsField {
     /// The control point nearest `u` among the grid cell's (a fallback where every weight has
     /// been shifted to zero by Eq. 4).
     fn nearest(&self, u: Vec2) -> usize {
-        let g = self.in_square(u);
-        let cell = |t: f32| ((t * self.cells as f32) as usize).min(self.cells - 1);
-        let c = cell(g.y) * self.cells + cell(g.x);
-        self.cell_centres[self.cell_start[c] as usize..self.cell_start[c + 1] as usize]
+        let (g, candidates) = self.candidates(u);
+        candidates
             .iter()
             .min_by(|a, b| {
                 let d = |i: u32| self.centres[i as usize].distance_squared(g);
