@@ -49,7 +49,7 @@ fn temporary_path(path: &Path) -> PathBuf {
 
 /// Write `path` through `write`, which writes the temporary file it is given; the temporary
 /// file is renamed over `path` only if `write` succeeds, and removed otherwise.
-pub(crate) fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let tmp = temporary_path(path);
     match write(&tmp) {
         Ok(()) => std::fs::rename(&tmp, path).map_err(|e| {

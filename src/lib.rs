@@ -40,6 +40,8 @@ pub mod deform;
 pub mod error;
 pub mod files;
 pub mod geometry;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod image;
 pub mod integrator;
 pub mod light;
@@ -49,6 +51,7 @@ pub mod math;
 pub mod pups;
 pub mod sampling;
 pub mod scene;
+pub mod shader;
 pub mod texture;
 pub mod tiles;
 

@@ -534,7 +534,10 @@ fn the_lattice_shows_where_mix_max_lets_the_tiles_centres_win_and_nowhere_else()
     // the exemplar's power at the paving's lattice frequencies. Mix-Max with its default
     // contrast (4) lets each tile's centre win whatever its priority while bright rocks win the
     // transitions: a grid of dark centres that the lattice visibility catches; a contrast of 32
-    // lets the rocks decide and the grid goes.
+    // lets the rocks decide and the grid goes. The figure is a noisy estimate: over sets of 4
+    // seeds, contrast 32 gave 1.14 to 1.66 and histogram preservation 0.49 to 1.33 (24 seeds,
+    // 2026-11-26), so it is averaged over 16 seeds, and contrast 32 is held to the level of a
+    // stationary texture (about 1, below 2) and far below contrast 4's grid (about 25).
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/textures/rocks_basecolor.jpg");
     let bitmap = tessera::image::read_bitmap(&path, tessera::image::ColorSpace::Srgb).unwrap();
     let image = ImageTexture {
@@ -557,13 +560,14 @@ fn the_lattice_shows_where_mix_max_lets_the_tiles_centres_win_and_nowhere_else()
             inset: false,
         };
         let texture = TilingBlending::new(Arc::new(synthesis), exemplar.clone()).unwrap();
-        tessera::texture::tiling_blending::synthesis_lattice_visibility(&texture, 256, &[3, 4, 5, 6]).unwrap()
+        let seeds: Vec<u64> = (3..19).collect();
+        tessera::texture::tiling_blending::synthesis_lattice_visibility(&texture, 256, &seeds).unwrap()
     };
     let histogram = visibility(Blend::HistogramPreserving);
     let mix_max =
         |contrast: f32| visibility(Blend::MixMax { priority: PriorityMap::new(&image), contrast, lambda: 0.05 });
     let (low, high) = (mix_max(4.0), mix_max(32.0));
     eprintln!("lattice visibility: histogram-preserving {histogram:.2}, Mix-Max contrast 4 {low:.2}, 32 {high:.2}");
-    assert!(histogram < 1.5 && high < 1.5, "{histogram} {high}");
-    assert!(low > 5.0, "{low}");
+    assert!(histogram < 1.5 && high < 2.0, "{histogram} {high}");
+    assert!(low > 5.0 && low > 10.0 * high, "{low} {high}");
 }

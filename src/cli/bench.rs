@@ -19,6 +19,11 @@
 //!   memory it adds (Linux), against pairing the same edges through a hash map; and the
 //!   synthesis of a 4 x 4 tile image of 256-texel tiles from `scenes/textures/rocks_basecolor.jpg`,
 //!   against resampling as many texels bilinearly.
+//! - The WGSL port (feature `gpu`): bakes of 4096 x 4096 point lookups of tiling and blending
+//!   of a 1024 x 1024 RGBA f32 exemplar (bilinear), classical and deformed by a 256 x 256 F map,
+//!   linear and Mix-Max, as `../shared/tools/gpu/tb_cuda.py` measures its CUDA yardstick; and
+//!   the deformed texture with EWA at one-texel footprints. Printed as lookups per second and
+//!   as ratios to the CPU bake of the same texture (512 x 512, all threads) in the same run.
 //! - Paper 002's PUPs: the paper's case, a 1000 x 1000 image of the `noise` preset from 700
 //!   control points (the paper reports 30 s), and single lookups per second against the bitmap
 //!   lookup of the texture figures, measured in the same run.
@@ -86,6 +91,9 @@ pub enum Suite {
     Tiles,
     /// Paper 002: a 1000 x 1000 PUPs image from 700 points; lookups per second.
     Pups,
+    /// The WGSL port on the GPU (feature `gpu`): deformed T&B lookups per second against the
+    /// CPU bake of the same texture.
+    Gpu,
 }
 
 /// Run the benchmarks of `suites` and print a table. `scene_dir` holds the shipped scenes.
@@ -113,6 +121,9 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> R
     }
     if suites.contains(&Suite::Pups) {
         pups(scene_dir, runs, &pool)?;
+    }
+    if suites.contains(&Suite::Gpu) {
+        gpu(runs, &pool)?;
     }
     Ok(())
 }
@@ -467,4 +478,90 @@ fn pups(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         bitmap_rate
     );
     Ok(())
+}
+
+/// The GPU figures (see the module's documentation).
+#[cfg(feature = "gpu")]
+fn gpu(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
+    use tessera::gpu::{Gpu, GpuBake};
+    use tessera::texture::{BakeFootprint, bake_rect};
+    let device = Gpu::new().map_err(|e| Error::param("gpu", e.0))?;
+    // A 1024 x 1024 RGBA exemplar of uniform noise, as the yardstick's.
+    let n = 1024;
+    let mut noise = Bitmap::new(n, n, 4);
+    for (i, v) in noise.data.iter_mut().enumerate() {
+        *v = Sampler::new(3, i as u64, 0).next_1d();
+    }
+    let exemplar = |filter| {
+        Arc::new(Texture::Image(ImageTexture {
+            mipmap: Arc::new(MipMap::new(noise.clone())),
+            filter,
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        }))
+    };
+    // The yardstick's F map: 256 x 256, a rotation growing along u to 1.5 rad, times 1.3.
+    let m = 256;
+    let mut map = Bitmap::new(m, m, 4);
+    for (i, px) in map.data.chunks_exact_mut(4).enumerate() {
+        let f = Mat2::from_angle(1.5 * (i % m) as f32 / (m - 1) as f32) * 1.3;
+        px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
+    }
+    let deformation = DeformationField::new(vec![Deformation::Map(MipMap::new(map))]);
+    let Texture::Image(plain) = exemplar(Filter::None).as_ref().clone() else { unreachable!("an image") };
+    let mix_max = Blend::MixMax { priority: PriorityMap::new(&plain), contrast: 4.0, lambda: 0.05 };
+    let cases = [
+        ("classical, linear", None, Blend::Linear, Filter::None, BakeFootprint::Point),
+        ("deformed, linear", Some(deformation.clone()), Blend::Linear, Filter::None, BakeFootprint::Point),
+        ("deformed, mix-max", Some(deformation.clone()), mix_max, Filter::None, BakeFootprint::Point),
+        ("deformed, linear, EWA", Some(deformation), Blend::Linear, Filter::Ewa, BakeFootprint::Texel),
+    ];
+    println!("gpu        {}", device.describe());
+    println!("           CPU: 512 x 512 bakes on {} threads", pool.current_num_threads());
+    for (name, deformation, blend, filter, footprint) in cases {
+        // The yardstick's lattice: spacing 1 / (8 sqrt 12) in UV.
+        let synthesis = Synthesis {
+            tiling: Tiling::Hexagonal,
+            tile_size: 0.036_084_39,
+            seed: 1,
+            deformation,
+            cuts: None,
+            blend,
+            inset: false,
+        };
+        let texture =
+            TilingBlending::new(Arc::new(synthesis), exemplar(filter)).map_err(|e| Error::param("bench", e))?;
+        let baker = GpuBake::new(&device, &texture).map_err(|e| Error::param("gpu", e.0))?;
+        // The yardstick's 4096 x 4096 bakes, as many per submission as fill about 0.2 s, on a
+        // GPU fast enough; 1024 x 1024 one at a time on a slow one (lavapipe).
+        let probe = median(baker.time(1024, 1024, footprint, 1, 1).map_err(|e| Error::param("gpu", e.0))?);
+        let (res, launches) =
+            if probe < 0.01 { (4096u32, ((0.2 / (16.0 * probe)) as usize).clamp(1, 50)) } else { (1024, 1) };
+        let seconds = baker.time(res, res, footprint, launches, runs).map_err(|e| Error::param("gpu", e.0))?;
+        let gpu_rate = (res as f64 * res as f64) / median(seconds);
+        let cpu_texture = Texture::TilingBlending(texture);
+        let cpu_rates = (0..runs)
+            .map(|_| {
+                let start = Instant::now();
+                pool.install(|| bake_rect(&cpu_texture, 512, 512, footprint));
+                512.0 * 512.0 / start.elapsed().as_secs_f64()
+            })
+            .collect();
+        let cpu_rate = median(cpu_rates);
+        println!(
+            "           {name:<24} {gpu_rate:9.3e} lookups/s on the GPU ({res} x {res}, {launches} per submission), \
+             {cpu_rate:9.3e} on the CPU ({:.2}x)",
+            gpu_rate / cpu_rate
+        );
+    }
+    Ok(())
+}
+
+/// Without the `gpu` feature: say how to build with it.
+#[cfg(not(feature = "gpu"))]
+fn gpu(_runs: usize, _pool: &rayon::ThreadPool) -> Result<()> {
+    Err(Error::param(
+        "--only gpu",
+        "this tessera was built without the `gpu` feature: cargo build --release --features gpu",
+    ))
 }

@@ -3,6 +3,7 @@
 
 mod bench;
 mod deform;
+mod gpu;
 mod pups;
 mod tiles;
 
@@ -159,6 +160,18 @@ enum Command {
         /// UV square sees it) or `point` (unfiltered).
         #[arg(long, default_value = "texel")]
         footprint: FootprintArg,
+        /// Bake on the GPU with the WGSL port (feature `gpu`; tiling_blending textures).
+        #[arg(long)]
+        gpu: bool,
+    },
+    /// Compare the WGSL port's bake of a tiling_blending texture with the CPU's, texel by
+    /// texel: per channel the largest and mean difference, the worst texels, an error image.
+    /// Exits 0 when every difference is within the tolerance, 1 otherwise (feature `gpu`).
+    GpuCheck(gpu::GpuCheckArgs),
+    /// The WGSL port of tiling and blending (`shaders/`), for engines.
+    Shader {
+        #[command(subcommand)]
+        command: gpu::ShaderCommand,
     },
     /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and its UV cuts:
     /// writes f_map.exr (F00, F01, F10, F11), cuts.json (the cut curves the synthesis' cut
@@ -218,6 +231,15 @@ enum Command {
 enum FootprintArg {
     Texel,
     Point,
+}
+
+impl From<FootprintArg> for BakeFootprint {
+    fn from(footprint: FootprintArg) -> Self {
+        match footprint {
+            FootprintArg::Texel => BakeFootprint::Texel,
+            FootprintArg::Point => BakeFootprint::Point,
+        }
+    }
 }
 
 /// Parse the command line and run it.
@@ -285,21 +307,23 @@ pub fn run() -> Result<ExitCode> {
             eprintln!("{}: wrote {} files to {}", scene.path.display(), export.files.len(), output.display());
             Ok(ExitCode::SUCCESS)
         }
-        Command::Bake { scene, texture, res, output, data, footprint } => {
+        Command::Bake { scene, texture, res, output, data, footprint, gpu } => {
             tessera::image::OutputFormat::from_path(&output)?;
             let tex = tessera::scene::load_texture(&scene, &texture, !data)?;
-            let footprint = match footprint {
-                FootprintArg::Texel => BakeFootprint::Texel,
-                FootprintArg::Point => BakeFootprint::Point,
-            };
+            let footprint = footprint.into();
             let start = Instant::now();
-            let image = bake(&tex, res as usize, footprint);
+            let (image, device) = if gpu {
+                let (image, adapter) = gpu::bake_on_gpu(&tex, &texture, res, footprint)?;
+                (image, format!(" on {adapter}"))
+            } else {
+                (bake(&tex, res as usize, footprint), String::new())
+            };
             let rgb = image.without_alpha();
             let mut alpha = Bitmap::new(image.width, image.height, 1);
             alpha.data = image.data.chunks_exact(4).map(|p| p[3]).collect();
             write_image(&output, &rgb, &[(&["A"], alpha)])?;
             eprintln!(
-                "{}: baked texture '{texture}' at {res}x{res} in {:.2} s to {}",
+                "{}: baked texture '{texture}' at {res}x{res}{device} in {:.2} s to {}",
                 scene.display(),
                 start.elapsed().as_secs_f64(),
                 output.display()
@@ -320,6 +344,11 @@ pub fn run() -> Result<ExitCode> {
                     );
                 }
             }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::GpuCheck(args) => gpu::check(&args),
+        Command::Shader { command } => {
+            gpu::shader(command)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Deform { mesh, output } => deform::deform(&mesh, &output),

@@ -13,6 +13,7 @@
 use super::Bitmap;
 use crate::color::linear_to_srgb;
 use crate::error::{Error, Result};
+use glam::Vec4;
 
 /// Sample variance below which the Z-test does not trust the reference (Mitsuba's floor).
 pub const MIN_VARIANCE: f64 = 1e-4;
@@ -207,5 +208,94 @@ mod tests {
         // A hot region fails the per-pixel test.
         let hot = image(w, h, |i| if i < w * h * 3 / 100 { noisy.data[i] + 1.0 } else { noisy.data[i] });
         assert!(!z_test(&hot, spp, &reference, &variance).unwrap().pixels_pass());
+    }
+}
+
+/// One texel where two images differ most.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexelError {
+    /// Column.
+    pub x: usize,
+    /// Row (0 at the top).
+    pub y: usize,
+    /// Largest absolute difference over the channels.
+    pub error: f32,
+    /// The test image's value.
+    pub test: Vec4,
+    /// The reference's value.
+    pub reference: Vec4,
+}
+
+/// A texel-by-texel comparison of two images of the same size and channels (`tessera
+/// gpu-check`): per channel the largest and the mean absolute difference, the worst texels,
+/// and the error image max_c |t - r|.
+#[derive(Clone, Debug)]
+pub struct TexelDifference {
+    /// Largest |t - r| per channel.
+    pub max_abs: Vec<f32>,
+    /// Mean |t - r| per channel.
+    pub mean_abs: Vec<f64>,
+    /// The texels of largest difference, largest first.
+    pub worst: Vec<TexelError>,
+    /// max over channels of |t - r|, one channel (NaN where either value is NaN).
+    pub error_image: Bitmap,
+}
+
+impl TexelDifference {
+    /// Compare `test` with `reference`, keeping the `worst` largest differences.
+    pub fn new(test: &Bitmap, reference: &Bitmap, worst: usize) -> Result<Self> {
+        if (test.width, test.height, test.channels) != (reference.width, reference.height, reference.channels) {
+            return Err(Error::param(
+                "images",
+                format!(
+                    "they differ in size: {}x{}x{} against {}x{}x{}",
+                    test.width, test.height, test.channels, reference.width, reference.height, reference.channels
+                ),
+            ));
+        }
+        let ch = test.channels;
+        let mut max_abs = vec![0.0f32; ch];
+        let mut sum = vec![0.0f64; ch];
+        let mut error_image = Bitmap::new(test.width, test.height, 1);
+        for (i, (t, r)) in test.data.chunks_exact(ch).zip(reference.data.chunks_exact(ch)).enumerate() {
+            let mut texel = 0.0f32;
+            for c in 0..ch {
+                let d = (t[c] - r[c]).abs();
+                // NaN poisons the maximum on purpose: a NaN in either image is a failure.
+                max_abs[c] = if d.is_nan() || max_abs[c].is_nan() { f32::NAN } else { max_abs[c].max(d) };
+                sum[c] += d as f64;
+                texel = if d.is_nan() || texel.is_nan() { f32::NAN } else { texel.max(d) };
+            }
+            error_image.data[i] = texel;
+        }
+        let count = (test.width * test.height).max(1) as f64;
+        let mut order: Vec<usize> = (0..error_image.data.len()).collect();
+        let key = |i: usize| if error_image.data[i].is_nan() { f32::INFINITY } else { error_image.data[i] };
+        order.sort_by(|&a, &b| key(b).total_cmp(&key(a)).then(a.cmp(&b)));
+        let worst = order
+            .into_iter()
+            .take(worst)
+            .map(|i| {
+                let (x, y) = (i % test.width, i / test.width);
+                TexelError {
+                    x,
+                    y,
+                    error: error_image.data[i],
+                    test: test.pixel(x, y),
+                    reference: reference.pixel(x, y),
+                }
+            })
+            .collect();
+        Ok(TexelDifference { max_abs, mean_abs: sum.into_iter().map(|s| s / count).collect(), worst, error_image })
+    }
+
+    /// The largest difference over all channels (NaN if any value was NaN).
+    pub fn max(&self) -> f32 {
+        self.max_abs.iter().fold(0.0f32, |m, &d| if d.is_nan() || m.is_nan() { f32::NAN } else { m.max(d) })
+    }
+
+    /// True when every difference is at most `tolerance` (and none is NaN).
+    pub fn within(&self, tolerance: f32) -> bool {
+        self.max() <= tolerance
     }
 }

@@ -16,6 +16,21 @@ pub enum BakeFootprint {
     Point,
 }
 
+/// A bake's parameters as the WGSL bake reads them (`shaders/bake.wgsl`, `BakeParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BakeParams {
+    /// Texels per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// 0: one texel ([`BakeFootprint::Texel`]); 1: a point.
+    pub footprint: u32,
+    /// The band's first row: a large bake runs as bands of rows that each fit one storage
+    /// buffer binding.
+    pub first_row: u32,
+}
+
 /// The RGBA texture over [0, 1]^2 at `res` x `res` texel centres. Row 0 is the top of the UV
 /// square (v near 1), as the texture conventions of DESIGN.md section 3 lay images out, so the
 /// bake of an image texture at the image's resolution with point lookups is the image itself.

@@ -22,9 +22,9 @@ pub enum Filter {
 }
 
 /// Longest-to-shortest axis ratio beyond which the EWA ellipse is widened (pbrt-v4's default).
-const MAX_ANISOTROPY: f32 = 8.0;
+pub const MAX_ANISOTROPY: f32 = 8.0;
 /// Entries of the Gaussian EWA weight table.
-const EWA_LUT_SIZE: usize = 128;
+pub const EWA_LUT_SIZE: usize = 128;
 
 /// Gaussian EWA weights exp(-2 r^2) - exp(-2) over r^2 in [0, 1] (pbrt's table).
 static EWA_WEIGHTS: std::sync::LazyLock<[f32; EWA_LUT_SIZE]> = std::sync::LazyLock::new(|| {
@@ -91,6 +91,18 @@ fn wrap(i: i64, n: usize) -> usize {
     } else {
         i.rem_euclid(n) as usize
     }
+}
+
+/// The Gaussian weight of a texel at squared ellipse radius `r2` in [0, 1): the table
+/// interpolated linearly between its nodes r2 = i / (EWA_LUT_SIZE - 1), so that the weight is
+/// continuous in r2 and a GPU, whose r2 differs from the CPU's in the last bits, gives the same
+/// filtered value to within those bits (`ewa_weight` in `shaders/tiling_blending/mipmap.wgsl`).
+#[inline(always)]
+fn ewa_weight(lut: &[f32; EWA_LUT_SIZE], r2: f32) -> f32 {
+    let x = r2 * (EWA_LUT_SIZE - 1) as f32;
+    let i = (x as usize).min(EWA_LUT_SIZE - 2);
+    let t = x - i as f32;
+    lut[i] * (1.0 - t) + lut[i + 1] * t
 }
 
 impl MipMap {
@@ -271,7 +283,7 @@ impl MipMap {
                 let ss = is as f32 - c.x;
                 let r2 = a * ss * ss + b * ss * tt + cc * tt * tt;
                 if r2 < 1.0 {
-                    let w = lut[((r2 * EWA_LUT_SIZE as f32) as usize).min(EWA_LUT_SIZE - 1)];
+                    let w = ewa_weight(lut, r2);
                     sum += self.texel(level, is, it) * w;
                     weights += w;
                 }

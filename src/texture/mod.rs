@@ -9,8 +9,8 @@ mod mipmap;
 mod quad_tiles;
 pub mod tiling_blending;
 
-pub use bake::{BakeFootprint, bake, bake_rect};
-pub use mipmap::{Filter, MipMap};
+pub use bake::{BakeFootprint, BakeParams, bake, bake_rect};
+pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MipMap};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
 
@@ -31,6 +31,14 @@ pub struct TexCtx {
     /// deformation field whose F map holds the other handedness there (overlapping mirrored UV
     /// islands) is mirrored to match ([`tiling_blending::DeformationField::at_surface`]).
     pub uv_mirrored: Option<bool>,
+}
+
+/// Image coordinates (s, t) of texture coordinates `uv`: s = u, t = 1 - v, so that t runs down
+/// from the image's top row (DESIGN.md section 3). The one v-flip of CPU lookups; the shaders'
+/// is `image_coordinates` in `shaders/tiling_blending/mipmap.wgsl`.
+#[inline]
+pub fn image_coordinates(uv: Vec2) -> Vec2 {
+    Vec2::new(uv.x, 1.0 - uv.y)
 }
 
 /// Which value of a texture a scalar parameter reads.
@@ -82,8 +90,7 @@ impl ImageTexture {
     /// Filtered value at the lookup.
     pub fn eval(&self, ctx: &TexCtx) -> Vec4 {
         let uv = ctx.uv * self.scale + self.offset;
-        // Image coordinates: x right, y down from the top row (DESIGN.md section 3).
-        let st = Vec2::new(uv.x, 1.0 - uv.y);
+        let st = image_coordinates(uv);
         self.mipmap.lookup(self.filter, st, self.image_step(ctx.duv_dx), self.image_step(ctx.duv_dy))
     }
 

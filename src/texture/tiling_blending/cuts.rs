@@ -219,7 +219,7 @@ impl CutBands {
         }
         let f_at = |uv: Vec2| {
             let i = ((uv.x * res as f32) as usize).min(res - 1);
-            let j = (((1.0 - uv.y) * res as f32) as usize).min(res - 1);
+            let j = ((crate::texture::image_coordinates(uv).y * res as f32) as usize).min(res - 1);
             let t = f_map.values(i, j);
             Mat2::from_cols(Vec2::new(t[0], t[2]), Vec2::new(t[1], t[3]))
         };
@@ -303,7 +303,7 @@ impl CutBands {
     #[inline]
     fn texel(&self, uv: Vec2) -> [BandRef; BANDS_PER_POINT] {
         let i = ((uv.x * self.res as f32).max(0.0) as usize).min(self.res - 1);
-        let j = (((1.0 - uv.y) * self.res as f32).max(0.0) as usize).min(self.res - 1);
+        let j = ((crate::texture::image_coordinates(uv).y * self.res as f32).max(0.0) as usize).min(self.res - 1);
         self.texels[j * self.res + i]
     }
 

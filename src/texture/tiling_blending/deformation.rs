@@ -56,7 +56,7 @@ impl Deformation {
             }
             Deformation::Map(map) => {
                 let uv = uv - crate::math::floor2(uv);
-                let f = map.bilinear(0, Vec2::new(uv.x, 1.0 - uv.y));
+                let f = map.bilinear(0, crate::texture::image_coordinates(uv));
                 Mat2::from_cols(Vec2::new(f.x, f.z), Vec2::new(f.y, f.w))
             }
         }
@@ -131,6 +131,11 @@ impl DeformationField {
     pub fn map_at(&self, uv: Vec2, uv_mirrored: Option<bool>) -> Option<Mat2> {
         let m = bounded(self.factors.iter().find(|f| matches!(f, Deformation::Map(_)))?.at(uv));
         Some(with_handedness(m, uv_mirrored))
+    }
+
+    /// The factors F_1 ... F_n.
+    pub fn factors(&self) -> &[Deformation] {
+        &self.factors
     }
 
     /// The first F map factor's texels (None without one).

@@ -105,6 +105,20 @@ impl GaussianizedExemplar {
         if t == 0.0 { at(level) } else { at(level) * (1.0 - t) + at(level + 1) * t }
     }
 
+    /// The inverse transformations as one image for a GPU: row L holds level L's tables, texel
+    /// i channel c the table of channel c at g = i / (LUT_SIZE - 1).
+    pub fn inverse_tables(&self) -> Bitmap {
+        let mut image = Bitmap::new(LUT_SIZE, self.luts.len(), 4);
+        for (row, tables) in image.data.chunks_exact_mut(LUT_SIZE * 4).zip(&self.luts) {
+            for (i, texel) in row.chunks_exact_mut(4).enumerate() {
+                for (value, table) in texel.iter_mut().zip(tables) {
+                    *value = table[i];
+                }
+            }
+        }
+        image
+    }
+
     /// Approximate memory held, in bytes.
     pub fn memory_bytes(&self) -> usize {
         self.gaussian.mipmap.memory_bytes() + self.luts.len() * 4 * LUT_SIZE * 4
@@ -172,7 +186,7 @@ mod tests {
         let n = 64;
         for (x, y) in [(3, 5), (17, 40), (63, 0), (31, 31)] {
             let st = Vec2::new((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
-            let ctx = TexCtx { uv: Vec2::new(st.x, 1.0 - st.y), ..Default::default() };
+            let ctx = TexCtx { uv: crate::texture::image_coordinates(st), ..Default::default() };
             let back = g.invert(g.eval(&ctx), &ctx).x;
             let original = ex.eval(&ctx).x;
             // The table's resolution limits the round trip.

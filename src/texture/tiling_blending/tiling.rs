@@ -1,6 +1,6 @@
 //! The pavings of tiling and blending (paper 000 Sec. 3.1; DESIGN.md section 4): which tiles
-//! cover a point, their centres c_i, their weights w_i (a partition of unity), and their
-//! pseudo-random shifts h_i.
+//! cover a point, their centres c_i and their weights w_i (a partition of unity).
+//! `shaders/tiling_blending/tiling.wgsl` is the GPU port of this file.
 
 use crate::math::{floor, floor2};
 use glam::{IVec2, Vec2};
@@ -124,27 +124,6 @@ fn square(uv: Vec2, size: f32) -> [Tile; MAX_TILES] {
     ]
 }
 
-/// The pseudo-random shift h of a lattice vertex under `seed`: uniform over the exemplar's unit
-/// square (the exemplar repeats with period 1).
-#[inline]
-pub fn shift(vertex: IVec2, seed: u64) -> Vec2 {
-    shift_of_key(seed ^ ((vertex.x as u32 as u64) << 32 | vertex.y as u32 as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
-}
-
-/// The shift of tile `m` of the row along cut `curve` under `seed` ([`super::CutBands`]),
-/// drawn like a lattice vertex's from a separate key space.
-#[inline]
-pub fn cut_shift(curve: u32, m: i64, seed: u64) -> Vec2 {
-    let key = (curve as u64 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93) ^ (m as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    shift_of_key(seed.rotate_left(29) ^ key)
-}
-
-#[inline]
-fn shift_of_key(key: u64) -> Vec2 {
-    let bits = crate::sampling::mix64(key);
-    Vec2::new((bits >> 40) as f32, ((bits >> 16) & 0xff_ffff) as f32) * (1.0 / 16_777_216.0)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,25 +196,5 @@ mod tests {
                 uv = next;
             }
         }
-    }
-
-    #[test]
-    fn shifts_are_uniform_and_differ_between_vertices() {
-        let n = 64;
-        let mut sum = Vec2::ZERO;
-        let mut seen = std::collections::HashSet::new();
-        for i in -n / 2..n / 2 {
-            for j in -n / 2..n / 2 {
-                let h = shift(IVec2::new(i, j), 7);
-                assert!(h.cmpge(Vec2::ZERO).all() && h.cmplt(Vec2::ONE).all());
-                sum += h;
-                seen.insert((h.x.to_bits(), h.y.to_bits()));
-            }
-        }
-        let mean = sum / (n * n) as f32;
-        // Mean of 4096 uniforms: standard error 0.0045.
-        assert!((mean - Vec2::splat(0.5)).abs().max_element() < 0.02, "{mean}");
-        assert_eq!(seen.len(), (n * n) as usize);
-        assert_ne!(shift(IVec2::new(1, 2), 7), shift(IVec2::new(1, 2), 8));
     }
 }

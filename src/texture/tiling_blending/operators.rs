@@ -1,0 +1,209 @@
+//! The blending operators of tiling and blending (paper 000 Eq. 1 and DESIGN.md section 4): how
+//! the k tiles' exemplar values at a point are combined into one, linear, variance-preserving,
+//! histogram-preserving, sharpened (Mikkelsen 2022) or Mix-Max (Fournier and Sauvage 2024).
+//! `shaders/tiling_blending/operators.wgsl` is the GPU port of this file.
+
+use super::TileLookup;
+use super::synthesis::MAX_LOOKUPS;
+use crate::color::{Rgb, luminance};
+use crate::texture::{Channel, Filter, ImageTexture, MipMap, TexCtx, Texture};
+use glam::Vec4;
+use std::sync::Arc;
+
+/// How the tiles covering a point are combined (DESIGN.md section 4).
+#[derive(Clone, Debug)]
+pub enum Blend {
+    /// T = sum w_i E_i (Eq. 1) with the paving's weights.
+    Linear,
+    /// T = m + sum w_i (E_i - m) / sqrt(sum w_i^2), m the exemplar's mean (Heitz-Neyret 2018):
+    /// keeps the variance of a Gaussian exemplar where linear blending lowers it.
+    VariancePreserving,
+    /// Variance-preserving blending of the Gaussianized exemplar, then its inverse histogram
+    /// transformation, prefiltered per MIP level (Heitz-Neyret 2018, Deliot-Heitz 2019): keeps
+    /// the exemplar's histogram.
+    HistogramPreserving,
+    /// Mikkelsen 2022 ("Practical Real-Time Hex-Tiling", JCGT 11(3)): weights
+    /// w_i' = lerp(1, L_i, luminance_contrast) w_i^exponent, normalised, L_i the luminance of
+    /// `source` (the exemplar of the synthesis' first layer) read by tile i.
+    Sharpened {
+        /// Power on the paving's weights (Mikkelsen's default 7).
+        exponent: f32,
+        /// How much the tiles' luminance weighs (Mikkelsen's default 0.6).
+        luminance_contrast: f32,
+        /// The texture whose luminance weights the tiles.
+        source: Arc<Texture>,
+    },
+    /// Mix-Max (Fournier and Sauvage 2024): each tile has the priority c s_i + ln w_i, s_i its
+    /// priority map's mean over the footprint and c the priority contrast; with the footprint's
+    /// variance of c s_i, sigma_i^2, and the micro-priority spread lambda, tile i beats tile j with probability
+    /// Phi(((s_i + ln w_i) - (s_j + ln w_j)) / sqrt(sigma_i^2 + sigma_j^2 + 2 lambda^2)), and its
+    /// weight is the product of those over the other tiles, normalised (exact for two tiles; a
+    /// hard maximum when the variances and lambda are 0). The ln w_i term makes a tile lose
+    /// before its weight reaches 0, so that the result is continuous at tile borders.
+    MixMax {
+        /// The priority map.
+        priority: PriorityMap,
+        /// Factor c on the priorities against the paving's ln w_i: larger values let the
+        /// exemplar's content, rather than the tile shapes, decide where tiles cut.
+        contrast: f32,
+        /// Spread of the sub-footprint priorities: 0 cuts sharply, larger values blend.
+        lambda: f32,
+    },
+}
+
+/// A scalar priority map (the mean of its RGB) stored with its square in one two-channel MIP
+/// pyramid, so that one filtered lookup gives both the priority's mean and its variance over a
+/// footprint. The map is stored less its mean over the image: Mix-Max reads only differences
+/// of priorities and their variances, which a constant does not change, and the variance
+/// E[s^2] - E[s]^2 then cancels less (at a contrast of 32 its rounding weighs on the weights).
+#[derive(Clone, Debug)]
+pub struct PriorityMap {
+    /// Channels: s - mean, (s - mean)^2 (read back as RGB = s - mean, A = its square).
+    map: ImageTexture,
+}
+
+impl PriorityMap {
+    /// The priority map of an image (its RGB mean).
+    pub fn new(image: &ImageTexture) -> Self {
+        let base = image.mipmap.level(0);
+        let mut moments = crate::image::Bitmap::new(base.width, base.height, 2);
+        let count = (base.width * base.height) as f64;
+        let mut total = 0.0f64;
+        for y in 0..base.height {
+            for x in 0..base.width {
+                total += Channel::Mean.select(base.pixel(x, y)) as f64;
+            }
+        }
+        let mean = (total / count) as f32;
+        for y in 0..base.height {
+            for x in 0..base.width {
+                let s = Channel::Mean.select(base.pixel(x, y)) - mean;
+                moments.values_mut(x, y).copy_from_slice(&[s, s * s]);
+            }
+        }
+        let map = ImageTexture {
+            mipmap: Arc::new(MipMap::new(moments)),
+            filter: image.filter,
+            scale: image.scale,
+            offset: image.offset,
+        };
+        PriorityMap { map }
+    }
+
+    /// The map: RGB = s, A = s^2.
+    pub fn image(&self) -> &ImageTexture {
+        &self.map
+    }
+
+    /// Mean and variance of the priority over the lookup's footprint.
+    #[inline]
+    pub(super) fn mean_and_variance(&self, ctx: &TexCtx) -> (f32, f32) {
+        let v = self.map.eval(ctx);
+        (v.x, (v.w - v.x * v.x).max(0.0))
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.map.mipmap.memory_bytes()
+    }
+}
+
+impl Blend {
+    /// The blending weights of the tiles: the paving's for the linear and variance-preserving
+    /// operators, reweighted and normalised for the others. `values` are the tiles' exemplar
+    /// values and `exemplar` their texture (reused when it is the weights' source).
+    pub(super) fn weights(
+        &self,
+        lookups: &[TileLookup],
+        values: &[Vec4],
+        exemplar: Option<&Arc<Texture>>,
+    ) -> [f32; MAX_LOOKUPS] {
+        let k = lookups.len();
+        let mut w = [0.0; MAX_LOOKUPS];
+        match self {
+            Blend::Linear | Blend::VariancePreserving | Blend::HistogramPreserving => {
+                for i in 0..k {
+                    w[i] = lookups[i].weight;
+                }
+                return w;
+            }
+            Blend::Sharpened { exponent, luminance_contrast, source } => {
+                let same = exemplar.is_some_and(|e| Arc::ptr_eq(e, source));
+                for i in 0..k {
+                    let v = if same { values[i] } else { source.eval(&lookups[i].ctx) };
+                    let lum = luminance(Rgb::new(v.x, v.y, v.z));
+                    let factor = 1.0 + (lum - 1.0) * luminance_contrast;
+                    w[i] = factor.max(0.0) * lookups[i].weight.powf(*exponent);
+                }
+            }
+            Blend::MixMax { priority, contrast, lambda } => {
+                let mut score = [f32::NEG_INFINITY; MAX_LOOKUPS];
+                let mut variance = [0.0; MAX_LOOKUPS];
+                // Tiles of weight 0 (outside a cut band's reach) take no part.
+                let live = |i: usize| lookups[i].weight > 0.0;
+                for i in (0..k).filter(|&i| live(i)) {
+                    let (s, var) = priority.mean_and_variance(&lookups[i].ctx);
+                    score[i] = contrast * s + lookups[i].weight.ln();
+                    variance[i] = contrast * contrast * var;
+                }
+                for i in (0..k).filter(|&i| live(i)) {
+                    w[i] = (0..k)
+                        .filter(|&j| j != i && live(j))
+                        .map(|j| {
+                            win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda)
+                        })
+                        .product();
+                }
+            }
+        }
+        let sum: f32 = w[..k].iter().sum();
+        if sum > 0.0 {
+            w.iter_mut().for_each(|x| *x /= sum);
+        } else {
+            // Every tile lost every duel (ties at zero spread): fall back to the paving.
+            for i in 0..k {
+                w[i] = lookups[i].weight;
+            }
+        }
+        w
+    }
+
+    /// Bytes held by the operator's maps.
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            Blend::MixMax { priority, .. } => priority.memory_bytes(),
+            _ => 0,
+        }
+    }
+
+    /// True when the weights read a filtered texture.
+    pub fn uses_footprint(&self) -> bool {
+        match self {
+            Blend::Sharpened { source, .. } => source.uses_footprint(),
+            Blend::MixMax { priority, .. } => priority.map.filter != Filter::None,
+            _ => false,
+        }
+    }
+}
+
+/// P(X > 0) for X normal with mean `difference` and variance `variance`; a step (1/2 at 0) when
+/// the variance is 0.
+#[inline]
+fn win_probability(difference: f32, variance: f32) -> f32 {
+    if variance > 0.0 {
+        crate::math::normal_cdf_f32(difference / variance.sqrt())
+    } else if difference > 0.0 {
+        1.0
+    } else if difference < 0.0 {
+        0.0
+    } else {
+        0.5
+    }
+}
+
+/// m + sum w_i (v_i - m) / sqrt(sum w_i^2).
+#[inline]
+pub(super) fn variance_preserving(w: &[f32], values: &[Vec4], mean: Vec4) -> Vec4 {
+    let norm = w.iter().map(|w| w * w).sum::<f32>().sqrt();
+    let deviation: Vec4 = w.iter().zip(values).map(|(w, v)| (*v - mean) * *w).sum();
+    mean + deviation / norm
+}

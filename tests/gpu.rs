@@ -1,0 +1,248 @@
+//! The WGSL port of tiling and blending against the CPU, texel by texel (feature `gpu`; CI runs
+//! it on Mesa's lavapipe). Regime (a) of docs/gpu.md: filtering done in the shader in f32 with
+//! textureLoad must agree with the CPU bake to 1e-4 in every channel of every texel, for every
+//! paving, operator, filter and deformation factor the port takes. A machine with the feature
+//! on and no Vulkan driver fails here with what to install: these tests never pass without
+//! running.
+
+mod common;
+
+use glam::{Mat2, Vec2};
+use std::sync::Arc;
+use tessera::gpu::{Gpu, GpuBake};
+use tessera::image::Bitmap;
+use tessera::image::compare::TexelDifference;
+use tessera::texture::tiling_blending::{
+    Blend, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, TilingBlending,
+};
+use tessera::texture::{BakeFootprint, Filter, ImageTexture, MipMap, Texture, bake_rect};
+
+/// Regime (a)'s tolerance: largest absolute difference in any channel of any texel.
+const TOLERANCE: f32 = 1e-4;
+
+fn gpu() -> Gpu {
+    Gpu::new().unwrap_or_else(|e| panic!("the GPU tests need a Vulkan device: {e}"))
+}
+
+/// A 96 x 64 RGBA exemplar with structure at several scales (not a power of two, so that the
+/// pyramid's odd levels are exercised), values in [0, 1], each channel's histogram without
+/// wide gaps (see [`histogram_preservation_amplifies_rounding_by_the_slope_of_its_inverse`]).
+fn exemplar_image() -> Bitmap {
+    let (w, h) = (96, 64);
+    let mut b = Bitmap::new(w, h, 4);
+    for y in 0..h {
+        for x in 0..w {
+            let (u, v) = (x as f32 / w as f32, y as f32 / h as f32);
+            let r = 0.5 + 0.5 * (std::f32::consts::TAU * (3.0 * u + v)).sin();
+            let g = 0.5 + 0.4 * (std::f32::consts::TAU * u * 4.0).sin() * (std::f32::consts::TAU * v * 3.0).cos();
+            let bl =
+                0.5 + 0.3 * (std::f32::consts::TAU * (u * u + 2.0 * v)).cos() * (std::f32::consts::TAU * 5.0 * u).sin();
+            let a = 0.25 + 0.5 * v;
+            b.values_mut(x, y).copy_from_slice(&[r, g, bl, a]);
+        }
+    }
+    b
+}
+
+fn image(bitmap: Bitmap, filter: Filter) -> ImageTexture {
+    ImageTexture { mipmap: Arc::new(MipMap::new(bitmap)), filter, scale: Vec2::ONE, offset: Vec2::ZERO }
+}
+
+/// A 16 x 16 F map: rotation by an angle growing along u and a scale growing along v.
+fn f_map() -> MipMap {
+    let n = 16;
+    let mut b = Bitmap::new(n, n, 4);
+    for y in 0..n {
+        for x in 0..n {
+            let angle = x as f32 / n as f32 * 2.0;
+            let s = 1.0 + y as f32 / n as f32;
+            let (sn, cs) = angle.sin_cos();
+            b.values_mut(x, y).copy_from_slice(&[s * cs, -s * sn, s * sn, s * cs]);
+        }
+    }
+    MipMap::new(b)
+}
+
+fn deformations() -> Vec<(&'static str, Option<DeformationField>)> {
+    let field = |factors| Some(DeformationField::new(factors));
+    vec![
+        ("none", None),
+        ("constant", field(vec![Deformation::Constant(Mat2::from_cols_array(&[1.5, 0.3, -0.2, 0.8]))])),
+        ("rotation", field(vec![Deformation::Rotation { angle: 0.3, gradient: Vec2::new(2.5, -1.0) }])),
+        ("scale", field(vec![Deformation::Scale { scale: Vec2::new(2.0, 0.7), gradient: Vec2::new(0.5, 1.0) }])),
+        ("shear", field(vec![Deformation::Shear { shear: 0.4, gradient: Vec2::new(0.0, 1.5) }])),
+        ("map", field(vec![Deformation::Map(f_map())])),
+        (
+            "map, rotation, scale",
+            field(vec![
+                Deformation::Map(f_map()),
+                Deformation::Rotation { angle: -0.5, gradient: Vec2::new(0.0, 3.0) },
+                Deformation::Scale { scale: Vec2::splat(1.5), gradient: Vec2::ZERO },
+            ]),
+        ),
+    ]
+}
+
+fn blends(filter: Filter) -> Vec<(&'static str, Blend)> {
+    let priority = PriorityMap::new(&image(exemplar_image(), filter));
+    vec![
+        ("linear", Blend::Linear),
+        ("variance_preserving", Blend::VariancePreserving),
+        ("histogram_preserving", Blend::HistogramPreserving),
+        ("mix_max", Blend::MixMax { priority: priority.clone(), contrast: 4.0, lambda: 0.05 }),
+        ("mix_max, hard", Blend::MixMax { priority, contrast: 4.0, lambda: 0.0 }),
+    ]
+}
+
+/// A hexagonal synthesis of `exemplar` with `blend` and `deformation`, no cut bands.
+fn hexagonal(exemplar: Arc<Texture>, blend: Blend, deformation: Option<DeformationField>, seed: u64) -> TilingBlending {
+    let synthesis =
+        Synthesis { tiling: Tiling::Hexagonal, tile_size: 0.23, seed, deformation, cuts: None, blend, inset: false };
+    TilingBlending::new(Arc::new(synthesis), exemplar).unwrap()
+}
+
+/// The GPU and CPU bakes of `texture` at `width` x `height` and their difference.
+fn compare(gpu: &Gpu, texture: &TilingBlending, width: u32, height: u32, footprint: BakeFootprint) -> TexelDifference {
+    let baker = GpuBake::new(gpu, texture).unwrap_or_else(|e| panic!("{e}"));
+    let on_gpu = baker.bake(width, height, footprint).unwrap_or_else(|e| panic!("{e}"));
+    let on_cpu = bake_rect(&Texture::TilingBlending(texture.clone()), width as usize, height as usize, footprint);
+    TexelDifference::new(&on_gpu, &on_cpu, 3).unwrap()
+}
+
+#[test]
+fn every_configuration_matches_the_cpu_bake() {
+    let gpu = gpu();
+    eprintln!("GPU: {}", gpu.describe());
+    let mut failures = Vec::new();
+    let mut cases = 0;
+    for filter in [Filter::None, Filter::Trilinear, Filter::Ewa] {
+        let exemplar = Arc::new(Texture::Image(image(exemplar_image(), filter)));
+        for (blend_name, blend) in blends(filter) {
+            for (deformation_name, deformation) in deformations() {
+                for tiling in [Tiling::Hexagonal, Tiling::Square] {
+                    let inset = cases % 3 == 0;
+                    let synthesis = Arc::new(Synthesis {
+                        tiling,
+                        tile_size: 0.23,
+                        seed: 5 + cases as u64,
+                        deformation: deformation.clone(),
+                        cuts: None,
+                        blend: blend.clone(),
+                        inset,
+                    });
+                    let texture = TilingBlending::new(synthesis, exemplar.clone()).unwrap();
+                    for footprint in [BakeFootprint::Texel, BakeFootprint::Point] {
+                        cases += 1;
+                        let diff = compare(&gpu, &texture, 48, 40, footprint);
+                        let case = format!(
+                            "{filter:?} {blend_name} {deformation_name} {tiling:?} inset {inset} {footprint:?}: max {:.2e}",
+                            diff.max()
+                        );
+                        if !diff.within(TOLERANCE) {
+                            failures.push(format!("{case}, worst {:?}", diff.worst[0]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} cases differ by more than {TOLERANCE}:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn shipped_scenes_match_the_cpu_bake() {
+    let gpu = gpu();
+    let scenes = ["fig2_rotation", "fig2_scaling", "fig2_shearing", "brushed_tb", "pbr_rocks", "fig4/fig4"];
+    let mut checked = 0;
+    for name in scenes {
+        let path = common::repo().join(format!("scenes/{name}.toml"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        let table: toml::Table = text.parse().unwrap();
+        for (texture_name, item) in table["textures"].as_table().unwrap() {
+            if item.get("type").and_then(|t| t.as_str()) != Some("tiling_blending") {
+                continue;
+            }
+            let texture = tessera::scene::load_texture(&path, texture_name, true).unwrap();
+            let Texture::TilingBlending(t) = &texture else { unreachable!() };
+            let diff = compare(&gpu, t, 96, 96, BakeFootprint::Texel);
+            eprintln!("{name} {texture_name}: max |gpu - cpu| {:.2e}", diff.max());
+            assert!(diff.within(TOLERANCE), "{name} {texture_name}: {:?}", diff.worst);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 8, "only {checked} textures checked");
+}
+
+#[test]
+fn what_the_port_lacks_is_an_error_naming_it() {
+    let gpu = gpu();
+    let exemplar = Arc::new(Texture::Image(image(exemplar_image(), Filter::None)));
+    let sharpened = Blend::Sharpened { exponent: 7.0, luminance_contrast: 0.6, source: exemplar.clone() };
+    let texture = hexagonal(exemplar, sharpened, None, 1);
+    let error = GpuBake::new(&gpu, &texture).err().expect("the sharpened operator is not ported");
+    assert!(error.0.contains("sharpened"), "{error}");
+}
+
+#[test]
+fn gpu_bakes_are_deterministic() {
+    let gpu = gpu();
+    let exemplar = Arc::new(Texture::Image(image(exemplar_image(), Filter::Ewa)));
+    let texture = hexagonal(exemplar, Blend::HistogramPreserving, deformations().pop().unwrap().1, 1);
+    let baker = GpuBake::new(&gpu, &texture).unwrap();
+    let a = baker.bake(64, 64, BakeFootprint::Texel).unwrap();
+    let b = baker.bake(64, 64, BakeFootprint::Texel).unwrap();
+    assert_eq!(a, b);
+}
+
+/// The exported GLSL compiles with a stock compiler (Khronos' glslangValidator, Debian
+/// glslang-tools), as an engine's build would.
+#[test]
+fn exported_glsl_compiles_with_glslang() {
+    let glsl = tessera::shader::export(tessera::shader::ShaderLanguage::Glsl).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("tiling_blending.comp");
+    std::fs::write(&path, glsl).unwrap();
+    let output = std::process::Command::new("glslangValidator")
+        .arg("-V")
+        .arg(&path)
+        .arg("-o")
+        .arg(dir.path().join("tiling_blending.spv"))
+        .output()
+        .unwrap_or_else(|e| panic!("glslangValidator (Debian glslang-tools) is needed: {e}"));
+    assert!(
+        output.status.success(),
+        "glslangValidator rejected the exported GLSL:\n{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// Histogram preservation reads T^-1 from a table: where the exemplar's histogram has a gap, the
+/// table is steep (a binary channel jumps from 0.1 to 0.9 within one entry, a slope of about
+/// 0.8 x 255), and the few-ulp differences between the CPU's and the GPU's blended Gaussian
+/// value g (exp, sqrt and summation order) come out multiplied by that slope. This measures
+/// the effect on a binary checker and holds it to the bound the slope gives (|dg| <= 2e-6);
+/// docs/gpu.md tells shader authors what to expect.
+#[test]
+fn histogram_preservation_amplifies_rounding_by_the_slope_of_its_inverse() {
+    let gpu = gpu();
+    let (w, h) = (64, 64);
+    let mut checker = Bitmap::new(w, h, 4);
+    for y in 0..h {
+        for x in 0..w {
+            let g = if (x / 8 + y / 8) % 2 == 0 { 0.9 } else { 0.1 };
+            checker.values_mut(x, y).copy_from_slice(&[g, g, g, 1.0]);
+        }
+    }
+    let exemplar = Arc::new(Texture::Image(image(checker, Filter::Ewa)));
+    let texture = hexagonal(exemplar, Blend::HistogramPreserving, deformations().pop().unwrap().1, 3);
+    let diff = compare(&gpu, &texture, 64, 64, BakeFootprint::Point);
+    let slope = 0.8 * 255.0;
+    eprintln!("binary checker, histogram-preserving: max |gpu - cpu| {:.2e} (slope of T^-1 {slope})", diff.max());
+    assert!(diff.max() <= slope * 2e-6, "{:?}", diff.worst);
+}
