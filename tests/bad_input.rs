@@ -382,6 +382,33 @@ fn cli_bake_names_unknown_textures_and_writes_images() {
     assert_eq!((image.width, image.height, image.channels), (16, 16, 4));
 }
 
+#[test]
+fn gpu_commands_name_what_is_wrong() {
+    let dir = scene_dir(
+        &format!(
+            "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
+             [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n"
+        ),
+        &[("e.png", &png(image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))))],
+    );
+    let scene = dir.path().join("scene.toml");
+    let stderr_of = |args: &[&str]| {
+        let out = tessera().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let scene = scene.to_str().unwrap();
+    // Not a tiling-and-blending texture, with or without the `gpu` feature.
+    assert!(stderr_of(&["gpu-check", scene, "--texture", "e"]).contains("not a tiling_blending texture"));
+    assert!(stderr_of(&["gpu-check", scene, "--texture", "tb", "--tolerance", "NaN"]).contains("--tolerance"));
+    assert!(stderr_of(&["gpu-check", scene, "--texture", "nope"]).contains("unknown texture 'nope'"));
+    // The shader export writes atomically: a folder that does not exist is an error naming it.
+    let missing = dir.path().join("no/such/folder/t.glsl");
+    let msg = stderr_of(&["shader", "export", "--lang", "glsl", "-o", missing.to_str().unwrap()]);
+    assert!(msg.contains("no/such/folder"), "{msg}");
+    assert!(!missing.exists());
+}
+
 /// A small glTF document (`common::small_gltf`) edited by `edit`, as a GLB.
 fn edited_glb(edit: impl Fn(String) -> String) -> Vec<u8> {
     let (json, bin) = common::small_gltf();
