@@ -196,6 +196,7 @@ mod tests {
             match module.global_expressions[c.init] {
                 naga::Expression::Literal(naga::Literal::U32(v)) => v,
                 naga::Expression::Literal(naga::Literal::F32(v)) => v.to_bits(),
+                naga::Expression::Literal(naga::Literal::I32(v)) => v as u32,
                 ref other => panic!("{name}: {other:?}"),
             }
         };
@@ -216,6 +217,7 @@ mod tests {
             ("FACTOR_MAP", FACTOR_MAP),
             ("MAX_GPU_FACTORS", MAX_GPU_FACTORS as u32),
             ("EWA_LUT_SIZE", crate::texture::EWA_LUT_SIZE as u32),
+            ("MAX_EWA_SPAN", crate::texture::MAX_EWA_SPAN as u32),
             ("MAX_ANISOTROPY", crate::texture::MAX_ANISOTROPY.to_bits()),
             ("MAX_DEFORMATION", crate::texture::tiling_blending::MAX_DEFORMATION.to_bits()),
         ] {

@@ -50,6 +50,12 @@ const FILTER_EWA: u32 = 2u;
 const MAX_ANISOTROPY: f32 = 8.0;
 // Nodes of the Gaussian EWA weight table.
 const EWA_LUT_SIZE: u32 = 128u;
+// Most texel rows and columns an EWA loop visits. At the level EWA reads, the ellipse's shorter
+// axis is under 2 texels and its longer under 8 times that, widened by one texel: its bounding
+// box spans under 40, so the cap never changes a finite lookup (the CPU asserts the same span);
+// it bounds the loops whatever the footprint (NaN included), which lets the shader run without
+// wgpu's loop counters.
+const MAX_EWA_SPAN: i32 = 64;
 
 // The continuous level of a footprint of width `width` texels of the finest level.
 fn width_lod(params: ImageParams, width: f32) -> f32 {
@@ -140,9 +146,9 @@ fn ewa_level(image: texture_2d<f32>, level: u32, st: vec2<f32>, dst0: vec2<f32>,
     let u_sqrt = sqrt(max(det * cc, 0.0));
     let v_sqrt = sqrt(max(a * det, 0.0));
     let s0 = i32(ceil(c.x - 2.0 * inv_det * u_sqrt));
-    let s1 = i32(floor(c.x + 2.0 * inv_det * u_sqrt));
+    let s1 = min(i32(floor(c.x + 2.0 * inv_det * u_sqrt)), s0 + MAX_EWA_SPAN);
     let t0 = i32(ceil(c.y - 2.0 * inv_det * v_sqrt));
-    let t1 = i32(floor(c.y + 2.0 * inv_det * v_sqrt));
+    let t1 = min(i32(floor(c.y + 2.0 * inv_det * v_sqrt)), t0 + MAX_EWA_SPAN);
     var sum = vec4<f32>(0.0);
     var weights = 0.0;
     for (var y = t0; y <= t1; y++) {

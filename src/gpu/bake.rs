@@ -102,10 +102,23 @@ impl<'g> GpuBake<'g> {
         let lookup: GpuSynthesis = texture.gpu_synthesis().map_err(GpuError)?;
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let source = wgpu::ShaderModuleDescriptor {
             label: Some("tiling_blending"),
             source: wgpu::ShaderSource::Wgsl(wgsl_source().into()),
-        });
+        };
+        // wgpu bounds every loop with a hidden counter unless told otherwise; the counter keeps
+        // the compiler from unrolling the loops over the k tiles, whose arrays then live in
+        // local memory: the lookups ran 3 to 8 times slower on an H100 (docs/gpu.md). Bounds
+        // checks and integer division checks stay.
+        let mut checks = wgpu::ShaderRuntimeChecks::checked();
+        checks.force_loop_bounding = false;
+        // SAFETY: without the counter a loop that never ends would hang the GPU. Every loop of
+        // the shaders ends: the loops over tiles, factors and support corners run to constants
+        // (at most 4, 4 and 6: the factor count is checked against MAX_GPU_FACTORS before
+        // upload), and the EWA loops over texel rows and columns are capped at MAX_EWA_SPAN
+        // iterations (mipmap.wgsl), NaN footprints included.
+        #[allow(unsafe_code)]
+        let module = unsafe { device.create_shader_module_trusted(source, checks) };
         let synthesis_layout = synthesis_layout(gpu);
         let storage = wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: false },

@@ -25,6 +25,12 @@ pub enum Filter {
 pub const MAX_ANISOTROPY: f32 = 8.0;
 /// Entries of the Gaussian EWA weight table.
 pub const EWA_LUT_SIZE: usize = 128;
+/// Most texel rows and columns beyond the first that one EWA level visits. At the level EWA
+/// reads, the ellipse's shorter axis is under 2 texels and its longer under 8 times that, so its
+/// bounding box spans under 40 texels and the cap changes nothing, except on images whose
+/// levels stop halving along one axis (a 1024 x 1 image read with a footprint of many
+/// repeats): there it bounds the work, as the WGSL port must bound its loops.
+pub const MAX_EWA_SPAN: i64 = 64;
 
 /// Gaussian EWA weights exp(-2 r^2) - exp(-2) over r^2 in [0, 1] (pbrt's table).
 static EWA_WEIGHTS: std::sync::LazyLock<[f32; EWA_LUT_SIZE]> = std::sync::LazyLock::new(|| {
@@ -271,9 +277,9 @@ impl MipMap {
         let u_sqrt = (det * cc).max(0.0).sqrt();
         let v_sqrt = (a * det).max(0.0).sqrt();
         let s0 = (c.x - 2.0 * inv_det * u_sqrt).ceil() as i64;
-        let s1 = (c.x + 2.0 * inv_det * u_sqrt).floor() as i64;
+        let s1 = ((c.x + 2.0 * inv_det * u_sqrt).floor() as i64).min(s0 + MAX_EWA_SPAN);
         let t0 = (c.y - 2.0 * inv_det * v_sqrt).ceil() as i64;
-        let t1 = (c.y + 2.0 * inv_det * v_sqrt).floor() as i64;
+        let t1 = ((c.y + 2.0 * inv_det * v_sqrt).floor() as i64).min(t0 + MAX_EWA_SPAN);
         let lut = &*EWA_WEIGHTS;
         let mut sum = Vec4::ZERO;
         let mut weights = 0.0;

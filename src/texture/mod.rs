@@ -10,7 +10,7 @@ mod quad_tiles;
 pub mod tiling_blending;
 
 pub use bake::{BakeFootprint, BakeParams, bake, bake_rect};
-pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MipMap};
+pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
 
