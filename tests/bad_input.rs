@@ -355,15 +355,20 @@ fn bad_tiling_and_blending_textures_are_named() {
     );
 }
 
-#[test]
-fn cli_bake_names_unknown_textures_and_writes_images() {
-    let dir = scene_dir(
+/// A scene folder with an 8 x 8 image texture `e` and a tiling-and-blending texture `tb` of it.
+fn image_and_tiling_blending_scene() -> tempfile::TempDir {
+    scene_dir(
         &format!(
             "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
              [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n"
         ),
         &[("e.png", &png(image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))))],
-    );
+    )
+}
+
+#[test]
+fn cli_bake_names_unknown_textures_and_writes_images() {
+    let dir = image_and_tiling_blending_scene();
     let scene = dir.path().join("scene.toml");
     let missing = tessera()
         .arg("bake")
@@ -384,13 +389,7 @@ fn cli_bake_names_unknown_textures_and_writes_images() {
 
 #[test]
 fn gpu_commands_name_what_is_wrong() {
-    let dir = scene_dir(
-        &format!(
-            "{CAMERA}[textures.e]\ntype = \"image\"\nfilename = \"e.png\"\n\
-             [textures.tb]\ntype = \"tiling_blending\"\nexemplar = \"e\"\n"
-        ),
-        &[("e.png", &png(image::RgbImage::from_fn(8, 8, |x, y| image::Rgb([(x * 30) as u8, (y * 30) as u8, 100]))))],
-    );
+    let dir = image_and_tiling_blending_scene();
     let scene = dir.path().join("scene.toml");
     let stderr_of = |args: &[&str]| {
         let out = tessera().args(args).output().unwrap();

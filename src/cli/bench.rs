@@ -492,13 +492,10 @@ fn gpu(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
     for (i, v) in noise.data.iter_mut().enumerate() {
         *v = Sampler::new(3, i as u64, 0).next_1d();
     }
+    // One pyramid, read through each case's filter.
+    let pyramid = Arc::new(MipMap::new(noise));
     let exemplar = |filter| {
-        Arc::new(Texture::Image(ImageTexture {
-            mipmap: Arc::new(MipMap::new(noise.clone())),
-            filter,
-            scale: Vec2::ONE,
-            offset: Vec2::ZERO,
-        }))
+        Arc::new(Texture::Image(ImageTexture { mipmap: pyramid.clone(), filter, scale: Vec2::ONE, offset: Vec2::ZERO }))
     };
     // The yardstick's F map: 256 x 256, a rotation growing along u to 1.5 rad, times 1.3.
     let m = 256;
