@@ -28,6 +28,6 @@ fn bake(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let v = f32(height - 1u - row) + 0.5;
     let uv = vec2<f32>(f32(id.x) + 0.5, v) / size;
-    let ctx = TexCtx(uv, vec2<f32>(step.x, 0.0), vec2<f32>(0.0, step.y));
+    let ctx = TexCtx(uv, vec2<f32>(step.x, 0.0), vec2<f32>(0.0, step.y), SURFACE_NONE);
     bake_output[id.y * width + id.x] = tiling_blending(ctx);
 }

@@ -26,6 +26,9 @@ pub struct PerspectiveCamera {
     height: u32,
     /// The field of view as given, in degrees, and the axis it spans.
     fov: (f32, FovAxis),
+    /// tan of half the field of view along x and y: the film spans [-x, x] x [-y, y] at unit
+    /// distance in camera space.
+    tan_half: Vec2,
     /// World direction (not normalised) through the film's top-left corner, and its change
     /// for one pixel right and one pixel down: directions are affine in the film position.
     corner_direction: Vec3,
@@ -60,6 +63,7 @@ impl PerspectiveCamera {
             width,
             height,
             fov: (fov_degrees, fov_axis),
+            tan_half,
             corner_direction: to_world.transform_vector3(Vec3::new(-tan_half.x, tan_half.y, -1.0)),
             pixel_step: [
                 to_world.transform_vector3(Vec3::new(2.0 * tan_half.x / width as f32, 0.0, 0.0)),
@@ -108,6 +112,34 @@ impl PerspectiveCamera {
     /// Image size in pixels.
     pub fn resolution(&self) -> (u32, u32) {
         (self.width, self.height)
+    }
+
+    /// The same view at another image size, with one sample per pixel (ray differentials of
+    /// one pixel).
+    pub fn with_resolution(&self, width: u32, height: u32) -> Result<Self> {
+        Self::new(self.to_world, self.fov.0, self.fov.1, width, height, 1)
+    }
+
+    /// The world directions (not normalised) through the film's top-left corner and, added per
+    /// pixel, one pixel right and one pixel down: the ray through film point f (in pixels)
+    /// points along `corner + steps[0] f.x + steps[1] f.y`.
+    pub fn film_directions(&self) -> (Vec3, [Vec3; 2]) {
+        (self.corner_direction, self.pixel_step)
+    }
+
+    /// The projection of a rasteriser that sees what [`Self::generate_ray`] sees: world to clip
+    /// space, with reversed infinite depth (points at distance `near` in front of the camera
+    /// get depth 1, infinitely far ones 0). NDC x runs from -1 on the image's left edge to 1
+    /// on its right, y from 1 at the top to -1 at the bottom, so that the pixel centre
+    /// (x + 1/2, y + 1/2) of a WebGPU or Vulkan framebuffer is film point (x + 1/2, y + 1/2).
+    pub fn clip_from_world(&self, near: f32) -> Mat4 {
+        let projection = Mat4::from_cols(
+            glam::Vec4::new(1.0 / self.tan_half.x, 0.0, 0.0, 0.0),
+            glam::Vec4::new(0.0, 1.0 / self.tan_half.y, 0.0, 0.0),
+            glam::Vec4::new(0.0, 0.0, 0.0, -1.0),
+            glam::Vec4::new(0.0, 0.0, near, 0.0),
+        );
+        projection * self.to_world.inverse()
     }
 
     /// World direction (not normalised) through the film point `film` in pixels
@@ -206,6 +238,24 @@ mod tests {
         let (l, _) = c.generate_ray(Vec2::new(0.0, 16.0));
         let (r, _) = c.generate_ray(Vec2::new(64.0, 16.0));
         assert!((l.d.angle_between(r.d).to_degrees() - 40.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn the_rasteriser_projection_sees_what_the_rays_see() {
+        let c = camera();
+        let clip_from_world = c.clip_from_world(0.01);
+        for film in [Vec2::new(0.5, 0.5), Vec2::new(63.5, 2.5), Vec2::new(20.25, 31.5)] {
+            let (ray, _) = c.generate_ray(film);
+            for distance in [0.5, 3.0, 40.0] {
+                let clip = clip_from_world * ray.at(distance).extend(1.0);
+                let ndc = clip.truncate() / clip.w;
+                let pixel = Vec2::new((ndc.x + 1.0) * 0.5 * 64.0, (1.0 - ndc.y) * 0.5 * 32.0);
+                assert!(pixel.distance(film) < 1e-3, "{film} at {distance}: {pixel}");
+                // Depth: 1 at the near plane, falling as 1 / distance along the view axis.
+                let view_depth = -(c.to_world().inverse().transform_point3(ray.at(distance))).z;
+                assert!((ndc.z - 0.01 / view_depth).abs() < 1e-6, "depth {}", ndc.z);
+            }
+        }
     }
 
     #[test]

@@ -17,10 +17,14 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("tiling_blending/operators.wgsl", include_str!("../shaders/tiling_blending/operators.wgsl")),
     ("tiling_blending/synthesis.wgsl", include_str!("../shaders/tiling_blending/synthesis.wgsl")),
     ("bake.wgsl", include_str!("../shaders/bake.wgsl")),
+    ("view.wgsl", include_str!("../shaders/view.wgsl")),
 ];
 
 /// The compute entry point that bakes a texture over the UV square (`shaders/bake.wgsl`).
 pub const BAKE_ENTRY_POINT: &str = "bake";
+
+/// The vertex and fragment entry points of the rasterised view (`shaders/view.wgsl`).
+pub const VIEW_ENTRY_POINTS: (&str, &str) = ("view_vertex", "view_fragment");
 
 /// The whole WGSL module: the files of [`SHADER_FILES`] concatenated.
 pub fn wgsl_source() -> String {
@@ -133,6 +137,7 @@ pub fn export(language: ShaderLanguage) -> Result<String, ShaderError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::primary::{Derivatives, ViewParams, ViewTriangle};
     use crate::texture::tiling_blending::params::{FactorParams, ImageParams, SynthesisParams};
     use std::mem::{offset_of, size_of};
 
@@ -181,6 +186,14 @@ mod tests {
                 }),
             ),
             ("BakeParams", rust_layout!(crate::texture::BakeParams { width, height, footprint, first_row })),
+            (
+                "ViewParams",
+                rust_layout!(ViewParams { clip_from_world, eye, corner_direction, pixel_step_x, pixel_step_y }),
+            ),
+            (
+                "ViewTriangle",
+                rust_layout!(ViewTriangle { p0, p1, p2, ng, dpdu, dpdv, uv0, uv1, uv2, surface, padding }),
+            ),
         ];
         for (name, rust) in expected {
             assert_eq!(wgsl_layout(&module, name), rust, "{name}: WGSL (size, members) against Rust");
@@ -220,6 +233,12 @@ mod tests {
             ("MAX_EWA_SPAN", crate::texture::MAX_EWA_SPAN as u32),
             ("MAX_ANISOTROPY", crate::texture::MAX_ANISOTROPY.to_bits()),
             ("MAX_DEFORMATION", crate::texture::tiling_blending::MAX_DEFORMATION.to_bits()),
+            ("SURFACE_UNMIRRORED", crate::integrator::primary::SURFACE_UNMIRRORED),
+            ("SURFACE_MIRRORED", crate::integrator::primary::SURFACE_MIRRORED),
+            ("DERIVATIVES_DPDX", Derivatives::Dpdx.code()),
+            ("DERIVATIVES_COARSE", Derivatives::Coarse.code()),
+            ("DERIVATIVES_FINE", Derivatives::Fine.code()),
+            ("DERIVATIVES_RAY", Derivatives::Ray.code()),
         ] {
             assert_eq!(constant(name), value, "{name}");
         }

@@ -42,11 +42,26 @@ fn factor_at(kind: u32, factor: FactorParams, uv: vec2<f32>) -> mat2x2<f32> {
     }
 }
 
-// F at `uv` (the identity without factors).
-fn deformation_at(uv: vec2<f32>) -> mat2x2<f32> {
+// An F map's value `m` mirrored, M m, where its handedness (det < 0 or not) is not the
+// surface's (`surface`, one of SURFACE_*; as it is without a surface).
+fn with_handedness(m: mat2x2<f32>, surface: u32) -> mat2x2<f32> {
+    if surface != SURFACE_NONE && (determinant(m) < 0.0) != (surface == SURFACE_MIRRORED) {
+        return mat2x2<f32>(1.0, 0.0, 0.0, -1.0) * m;
+    }
+    return m;
+}
+
+// F at `uv` on a surface of handedness `surface` (DeformationField::at_surface: the F map
+// factor, of which the port takes one, is mirrored to the surface's handedness; the identity
+// without factors).
+fn deformation_on_surface(uv: vec2<f32>, surface: u32) -> mat2x2<f32> {
     var m = mat2x2<f32>(1.0, 0.0, 0.0, 1.0);
     for (var i = 0u; i < factor_count(); i++) {
-        let f = bounded(factor_at(factor_kind(i), synthesis.factors[i], uv));
+        let kind = factor_kind(i);
+        var f = bounded(factor_at(kind, synthesis.factors[i], uv));
+        if kind == FACTOR_MAP {
+            f = with_handedness(f, surface);
+        }
         if i == 0u {
             m = f;
         } else {
@@ -54,4 +69,9 @@ fn deformation_at(uv: vec2<f32>) -> mat2x2<f32> {
         }
     }
     return m;
+}
+
+// F at `uv`, without a surface (DeformationField::at).
+fn deformation_at(uv: vec2<f32>) -> mat2x2<f32> {
+    return deformation_on_surface(uv, SURFACE_NONE);
 }

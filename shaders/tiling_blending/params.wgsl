@@ -107,9 +107,18 @@ fn factor_kind(i: u32) -> u32 {
 // The inverse histogram tables: row L the tables of MIP level L, texel i at g = i / (width - 1).
 @group(0) @binding(4) var inverse_tables_image: texture_2d<f32>;
 
-// A lookup: texture coordinates (bottom-left origin, v up) and the footprint.
+// Whether the surface a lookup is on has its UV map mirrored (TexCtx::uv_mirrored on the CPU):
+// unknown without a surface (a bake of the UV square), or known from the sign of
+// (dp/du x dp/dv) . n at a ray hit.
+const SURFACE_NONE: u32 = 0u;
+const SURFACE_UNMIRRORED: u32 = 1u;
+const SURFACE_MIRRORED: u32 = 2u;
+
+// A lookup: texture coordinates (bottom-left origin, v up), the footprint, and the surface's
+// handedness (one of SURFACE_*).
 struct TexCtx {
     uv: vec2<f32>,
     duv_dx: vec2<f32>,
     duv_dy: vec2<f32>,
+    surface: u32,
 }

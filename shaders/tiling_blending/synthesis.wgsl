@@ -31,7 +31,7 @@ fn inset_shift(h: vec2<f32>, reach: vec2<f32>) -> vec2<f32> {
 // The tiles' exemplar lookups at `ctx` (Eq. 3).
 fn synthesis_lookups(ctx: TexCtx) -> Lookups {
     let tiles = paving_tiles(tiling_code(), ctx.uv, synthesis.tile_size);
-    let f = deformation_at(ctx.uv);
+    let f = deformation_on_surface(ctx.uv, ctx.surface);
     var out: Lookups;
     for (var i = 0u; i < tile_count(); i++) {
         let tile = tiles.tile[i];
@@ -40,7 +40,7 @@ fn synthesis_lookups(ctx: TexCtx) -> Lookups {
             h = inset_shift(h, tile_reach(tile.centre));
         }
         let offset = ctx.uv - tile.centre;
-        out.lookup[i] = TileLookup(TexCtx(f * offset + h, f * ctx.duv_dx, f * ctx.duv_dy), tile.weight);
+        out.lookup[i] = TileLookup(TexCtx(f * offset + h, f * ctx.duv_dx, f * ctx.duv_dy, SURFACE_NONE), tile.weight);
     }
     return out;
 }

@@ -511,7 +511,7 @@ fn gpu(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         ("classical, linear", None, Blend::Linear, Filter::None, BakeFootprint::Point),
         ("deformed, linear", Some(deformation.clone()), Blend::Linear, Filter::None, BakeFootprint::Point),
         ("deformed, mix-max", Some(deformation.clone()), mix_max, Filter::None, BakeFootprint::Point),
-        ("deformed, linear, EWA", Some(deformation), Blend::Linear, Filter::Ewa, BakeFootprint::Texel),
+        ("deformed, linear, EWA", Some(deformation.clone()), Blend::Linear, Filter::Ewa, BakeFootprint::Texel),
     ];
     println!("gpu        {}", device.describe());
     println!("           CPU: 512 x 512 bakes on {} threads", pool.current_num_threads());
@@ -551,6 +551,80 @@ fn gpu(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
             gpu_rate / cpu_rate
         );
     }
+    gpu_view(&device, exemplar(Filter::Trilinear), deformation, runs, pool)
+}
+
+/// Frames per second of `tessera gpu-view`'s rasterised view at 1920 x 1080: a floor to the
+/// horizon and a sphere, the deformed T&B texture (F map, linear blending, trilinear exemplar)
+/// on every surface, against tessera's pixel-centre lookups on the CPU in the same run.
+#[cfg(feature = "gpu")]
+fn gpu_view(
+    device: &tessera::gpu::Gpu,
+    exemplar: Arc<Texture>,
+    deformation: DeformationField,
+    runs: usize,
+    pool: &rayon::ThreadPool,
+) -> Result<()> {
+    use tessera::gpu::GpuView;
+    use tessera::integrator::primary::{Derivatives, primary_view};
+    let scene = tessera::scene::load_scene_str(
+        r#"
+        [render]
+        width = 1920
+        height = 1080
+        [camera]
+        fov = 40
+        eye = [0, 0.8, 3.2]
+        target = [0, 0.1, 0]
+        [materials.grey]
+        type = "diffuse"
+        reflectance = 0.5
+        [[shapes]]
+        type = "rectangle"
+        material = "grey"
+        transform = [{ scale = 20 }, { rotate = [1, 0, 0], angle = -90 }, { translate = [0, -0.6, -10] }]
+        [[shapes]]
+        type = "uv_sphere"
+        material = "grey"
+        transform = [{ scale = 0.6 }]
+        "#,
+        Path::new("bench-view.toml"),
+        &SceneOverrides::default(),
+    )?;
+    let synthesis = Synthesis {
+        tiling: Tiling::Hexagonal,
+        tile_size: 0.036_084_39,
+        seed: 1,
+        deformation: Some(deformation),
+        cuts: None,
+        blend: Blend::Linear,
+        inset: false,
+    };
+    let texture = TilingBlending::new(Arc::new(synthesis), exemplar).map_err(|e| Error::param("bench", e))?;
+    let view = GpuView::new(device, &scene, &scene.camera, &texture).map_err(|e| Error::param("gpu", e.0))?;
+    for derivatives in [Derivatives::Dpdx, Derivatives::Ray] {
+        let probe = median(view.time(derivatives, 1, 1).map_err(|e| Error::param("gpu", e.0))?);
+        let frames = ((0.2 / probe) as usize).clamp(1, 200);
+        let seconds = view.time(derivatives, frames, runs).map_err(|e| Error::param("gpu", e.0))?;
+        println!(
+            "           view, {:<18} {:9.1} frames/s at 1920 x 1080 ({frames} per submission)",
+            format!("{} derivatives", derivatives.name()),
+            1.0 / median(seconds)
+        );
+    }
+    let cpu_texture = Texture::TilingBlending(texture);
+    let camera = scene.camera.with_resolution(480, 270)?;
+    let cpu_fps = median(
+        (0..runs)
+            .map(|_| {
+                let start = Instant::now();
+                pool.install(|| primary_view(&scene, &camera, &cpu_texture));
+                // A 480 x 270 view is a 16th of the pixels.
+                1.0 / (16.0 * start.elapsed().as_secs_f64())
+            })
+            .collect(),
+    );
+    println!("           view on the CPU   {cpu_fps:9.3} frames/s at 1920 x 1080 (from 480 x 270, ray differentials)");
     Ok(())
 }
 

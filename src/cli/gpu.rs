@@ -1,11 +1,13 @@
-//! `tessera shader export`, `tessera bake --gpu` and `tessera gpu-check`: the WGSL port of
-//! tiling and blending, exported for engines and checked against the CPU texel by texel.
+//! `tessera shader export`, `tessera bake --gpu`, `tessera gpu-check` and `tessera gpu-view`:
+//! the WGSL port of tiling and blending, exported for engines and checked against the CPU texel
+//! by texel and pixel by pixel.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use tessera::error::{Error, Result};
 use tessera::image::Bitmap;
 use tessera::image::compare::TexelDifference;
+use tessera::integrator::primary::{Derivatives, PrimaryView, ViewDifference, primary_view};
 use tessera::shader::{ShaderLanguage, export};
 use tessera::texture::{BakeFootprint, Texture, bake};
 
@@ -147,4 +149,205 @@ fn write_error_image(path: &Path, error: &Bitmap) -> Result<()> {
         return Err(Error::param("--error-image", "the error image is written as .exr"));
     }
     tessera::image::write_image(path, error, &[])
+}
+
+/// `tessera gpu-view`'s arguments.
+#[derive(clap::Args)]
+pub struct GpuViewArgs {
+    /// Scene file (TOML): its meshes, its camera, and the texture.
+    scene: PathBuf,
+    /// Name of the tiling_blending texture (`[textures.NAME]`), drawn on every surface.
+    #[arg(long)]
+    texture: String,
+    /// View size, WIDTHxHEIGHT (default: the scene's).
+    #[arg(long, value_parser = parse_resolution)]
+    res: Option<(u32, u32)>,
+    /// The GPU view shown in the output image: its footprint from WGSL's dpdx, coarse or fine
+    /// screen-space derivatives, or from ray differentials as tessera computes them.
+    #[arg(long, value_enum, default_value = "dpdx")]
+    derivatives: Derivatives,
+    /// Largest absolute difference allowed between the GPU view with ray differentials and
+    /// tessera's, in any channel of any pixel where both see the same triangle.
+    #[arg(long, default_value_t = 1e-4)]
+    tolerance: f32,
+    /// How many of the worst pixels to print.
+    #[arg(long, default_value_t = 4)]
+    worst: usize,
+    /// Write the GPU view, tessera's and their difference side by side (.png or .exr).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Also time the GPU view: frames per second, median of 5 batches.
+    #[arg(long)]
+    time: bool,
+    /// Read 8-bit images as data (no sRGB decoding).
+    #[arg(long)]
+    data: bool,
+}
+
+/// "WIDTHxHEIGHT", each side at least 1 and within the render limits.
+fn parse_resolution(text: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(|| format!("'{text}' is not WIDTHxHEIGHT"))?;
+    let side = |s: &str| -> std::result::Result<u32, String> {
+        let v: u32 = s.trim().parse().map_err(|_| format!("'{s}' is not a whole number of pixels"))?;
+        if v == 0 || v > tessera::limits::MAX_RENDER_SIDE {
+            return Err(format!("{v} pixels is outside 1..={}", tessera::limits::MAX_RENDER_SIDE));
+        }
+        Ok(v)
+    };
+    let (w, h) = (side(w)?, side(h)?);
+    if w as u64 * h as u64 > tessera::limits::MAX_RENDER_PIXELS {
+        return Err(format!("{w}x{h} is more than {} pixels", tessera::limits::MAX_RENDER_PIXELS));
+    }
+    Ok((w, h))
+}
+
+/// What the GPU drew: a view per kind of derivatives, the adapter, and seconds per frame of
+/// the view shown where timed.
+struct GpuViews {
+    views: Vec<(Derivatives, PrimaryView)>,
+    adapter: String,
+    seconds_per_frame: Option<f64>,
+}
+
+#[cfg(feature = "gpu")]
+fn draw_on_gpu(
+    scene: &tessera::scene::Scene,
+    camera: &tessera::camera::PerspectiveCamera,
+    texture: &Texture,
+    args: &GpuViewArgs,
+) -> Result<GpuViews> {
+    let gpu = tessera::gpu::Gpu::new().map_err(gpu_error)?;
+    let view =
+        tessera::gpu::GpuView::new(&gpu, scene, camera, tiling_blending(texture, &args.texture)?).map_err(gpu_error)?;
+    let views =
+        Derivatives::ALL.iter().map(|&d| Ok((d, view.render(d).map_err(gpu_error)?))).collect::<Result<Vec<_>>>()?;
+    let seconds_per_frame = if args.time {
+        // Batches of about 0.2 s.
+        let probe = view.time(args.derivatives, 1, 1).map_err(gpu_error)?[0];
+        let frames = ((0.2 / probe) as usize).clamp(1, 1000);
+        let mut seconds = view.time(args.derivatives, frames, 5).map_err(gpu_error)?;
+        seconds.sort_by(f64::total_cmp);
+        Some(seconds[seconds.len() / 2])
+    } else {
+        None
+    };
+    Ok(GpuViews { views, adapter: gpu.describe(), seconds_per_frame })
+}
+
+#[cfg(not(feature = "gpu"))]
+fn draw_on_gpu(
+    _scene: &tessera::scene::Scene,
+    _camera: &tessera::camera::PerspectiveCamera,
+    texture: &Texture,
+    args: &GpuViewArgs,
+) -> Result<GpuViews> {
+    tiling_blending(texture, &args.texture)?;
+    Err(Error::param("gpu", "this tessera was built without the `gpu` feature: cargo build --release --features gpu"))
+}
+
+/// Run `tessera gpu-view`: exit 0 when the GPU view with ray differentials matches tessera's
+/// within the tolerance.
+pub fn view(args: &GpuViewArgs) -> Result<ExitCode> {
+    if args.tolerance.is_nan() || args.tolerance < 0.0 {
+        return Err(Error::param("--tolerance", "must be a number >= 0"));
+    }
+    if let Some(output) = &args.output {
+        tessera::image::OutputFormat::from_path(output)?;
+    }
+    let scene = tessera::scene::load_scene(&args.scene, &Default::default())?;
+    let texture = tessera::scene::load_texture(&args.scene, &args.texture, !args.data)?;
+    let (width, height) = args.res.unwrap_or((scene.settings.width, scene.settings.height));
+    let camera = scene.camera.with_resolution(width, height)?;
+    let gpu = draw_on_gpu(&scene, &camera, &texture, args)?;
+    let reference = primary_view(&scene, &camera, &texture);
+    let seen = reference.triangle.iter().filter(|&&t| t != 0).count();
+    println!("{}: texture '{}', {width}x{height} pixels, GPU {}", args.scene.display(), args.texture, gpu.adapter);
+    println!("  tessera: camera rays through pixel centres, ray differentials; {seen} pixels see a surface");
+    println!(
+        "  {:<7} {:>9} {:>9} {:>9}  {:>9} {:>9}  {:>9} {:>9} {:>9}",
+        "GPU", "compared", "coverage", "triangle", "max diff", "mean", "footprint", "error", ""
+    );
+    println!(
+        "  {:<7} {:>9} {:>9} {:>9}  {:>9} {:>9}  {:>9} {:>9} {:>9}",
+        "uses", "pixels", "differs", "differs", "", "", "median", "p99", "max"
+    );
+    let mut ray_difference = None;
+    for (derivatives, view) in &gpu.views {
+        let diff = ViewDifference::new(view, &reference, args.worst)?;
+        let mean = diff.value.mean_abs.iter().cloned().fold(0.0f64, f64::max);
+        println!(
+            "  {:<7} {:>9} {:>9} {:>9}  {:>9.2e} {:>9.2e}  {:>9.2e} {:>9.2e} {:>9.2e}",
+            derivatives.name(),
+            diff.compared,
+            diff.coverage_differs,
+            diff.triangle_differs,
+            diff.value.max(),
+            mean,
+            diff.footprint.median,
+            diff.footprint.p99,
+            diff.footprint.max
+        );
+        if *derivatives == Derivatives::Ray {
+            ray_difference = Some(diff);
+        }
+    }
+    println!("  (max and mean |gpu - tessera| over channels and the pixels both see on the same triangle;");
+    println!("   footprint error: max(|dx - dx'|, |dy - dy'|) / max(|dx'|, |dy'|), ' tessera's)");
+    let ray = ray_difference.expect("the ray view is drawn");
+    if !ray.value.worst.is_empty() {
+        println!("  worst pixels with ray differentials (x, y from the top-left):");
+    }
+    for t in &ray.value.worst {
+        println!(
+            "    ({:4}, {:4}) {:.3e}: gpu {:.6?} tessera {:.6?}",
+            t.x,
+            t.y,
+            t.error,
+            t.test.to_array(),
+            t.reference.to_array()
+        );
+    }
+    if let Some(seconds) = gpu.seconds_per_frame {
+        println!(
+            "  speed: {:.1} frames/s at {width}x{height} ({} derivatives; median of 5 batches)",
+            1.0 / seconds,
+            args.derivatives.name()
+        );
+    }
+    if let Some(output) = &args.output {
+        let shown = &gpu.views.iter().find(|(d, _)| *d == args.derivatives).expect("every kind is drawn").1;
+        write_side_by_side(output, shown, &reference, args.derivatives)?;
+    }
+    let pass = ray.value.within(args.tolerance);
+    println!(
+        "{}: with ray differentials, max |gpu - tessera| {:.3e} against the tolerance {:.1e}",
+        if pass { "PASS" } else { "FAIL" },
+        ray.value.max(),
+        args.tolerance
+    );
+    Ok(if pass { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+/// The GPU view, tessera's and 100 |gpu - tessera| side by side, captioned.
+fn write_side_by_side(path: &Path, gpu: &PrimaryView, reference: &PrimaryView, derivatives: Derivatives) -> Result<()> {
+    let rgb = |b: &Bitmap| {
+        let mut out = Bitmap::new(b.width, b.height, 3);
+        for (o, i) in out.data.chunks_exact_mut(3).zip(b.data.chunks_exact(4)) {
+            o.copy_from_slice(&i[..3]);
+        }
+        out
+    };
+    let mut error = Bitmap::new(gpu.value.width, gpu.value.height, 1);
+    for (i, e) in error.data.iter_mut().enumerate() {
+        let (g, r) = (&gpu.value.data[4 * i..4 * i + 4], &reference.value.data[4 * i..4 * i + 4]);
+        *e = 100.0 * g.iter().zip(r).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+    }
+    let cells = [
+        (rgb(&gpu.value), format!("GPU, {} derivatives", derivatives.name())),
+        (rgb(&reference.value), "tessera, ray differentials".to_string()),
+        (error, "100 |GPU - tessera|".to_string()),
+    ];
+    let grid = tessera::image::montage(&cells, 3, tessera::limits::MAX_RENDER_PIXELS)
+        .map_err(|msg| Error::param("--output", msg))?;
+    tessera::image::write_image(path, &grid, &[])
 }

@@ -168,6 +168,12 @@ enum Command {
     /// texel: per channel the largest and mean difference, the worst texels, an error image.
     /// Exits 0 when every difference is within the tolerance, 1 otherwise (feature `gpu`).
     GpuCheck(gpu::GpuCheckArgs),
+    /// Draw a mesh scene's primary visibility with a tiling_blending texture on every surface,
+    /// rasterised with the WGSL port in a fragment shader, beside tessera's lookups at
+    /// pixel-centre camera rays with ray differentials; print their difference for screen-space
+    /// derivatives (dpdx, coarse, fine) and for ray differentials in the shader. Exits 0 when
+    /// the latter is within the tolerance, 1 otherwise (feature `gpu`).
+    GpuView(gpu::GpuViewArgs),
     /// The WGSL port of tiling and blending (`shaders/`), for engines.
     Shader {
         #[command(subcommand)]
@@ -347,6 +353,7 @@ pub fn run() -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::GpuCheck(args) => gpu::check(&args),
+        Command::GpuView(args) => gpu::view(&args),
         Command::Shader { command } => {
             gpu::shader(command)?;
             Ok(ExitCode::SUCCESS)

@@ -138,6 +138,12 @@ impl SurfaceInteraction {
         }
     }
 
+    /// Whether the UV map is mirrored here: dp/du x dp/dv points against the geometric normal.
+    #[inline]
+    pub fn uv_mirrored(&self) -> bool {
+        self.dpdu.cross(self.dpdv).dot(self.ng) < 0.0
+    }
+
     /// Spawn a ray from the hit along `d`, offset off the surface to the side `d` points to.
     #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {

@@ -1,11 +1,11 @@
 //! The compute bake of a tiling-and-blending texture (`shaders/bake.wgsl`): the GPU twin of
 //! [`crate::texture::bake_rect`], texel for texel.
 
+use super::synthesis::{SynthesisGroup, layout_entry, shader_module, uniform_entry, wait};
 use super::{Gpu, GpuError};
 use crate::image::Bitmap;
-use crate::shader::{BAKE_ENTRY_POINT, wgsl_source};
-use crate::texture::tiling_blending::params::GpuSynthesis;
-use crate::texture::{BakeFootprint, BakeParams, MipMap, TilingBlending};
+use crate::shader::BAKE_ENTRY_POINT;
+use crate::texture::{BakeFootprint, BakeParams, TilingBlending};
 use wgpu::util::DeviceExt;
 
 /// Workgroup size of the bake entry point (8 x 8).
@@ -20,118 +20,27 @@ pub struct GpuBake<'g> {
     bake_layout: wgpu::BindGroupLayout,
 }
 
-/// An f32 RGBA texture holding every level of `levels`.
-fn upload_pyramid(gpu: &Gpu, label: &str, levels: &[&Bitmap]) -> wgpu::Texture {
-    let mut data = Vec::new();
-    for level in levels {
-        for y in 0..level.height {
-            for x in 0..level.width {
-                data.extend_from_slice(bytemuck::bytes_of(&level.pixel(x, y).to_array()));
-            }
-        }
-    }
-    gpu.device.create_texture_with_data(
-        &gpu.queue,
-        &wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: levels[0].width as u32,
-                height: levels[0].height as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        &data,
-    )
-}
-
-/// A MIP pyramid as a texture; a 1 x 1 placeholder for an image the synthesis does not read.
-fn upload_mipmap(gpu: &Gpu, label: &str, mipmap: Option<&MipMap>) -> wgpu::Texture {
-    let placeholder = Bitmap::new(1, 1, 4);
-    let levels: Vec<&Bitmap> = match mipmap {
-        Some(m) => (0..m.level_count()).map(|l| m.level(l)).collect(),
-        None => vec![&placeholder],
-    };
-    upload_pyramid(gpu, label, &levels)
-}
-
-fn layout_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
-}
-
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
-}
-
-/// The layout of `shaders/tiling_blending/params.wgsl`'s group 0: the parameter block and four
-/// unfilterable f32 textures read with textureLoad.
-fn synthesis_layout(gpu: &Gpu) -> wgpu::BindGroupLayout {
-    let texture = |binding| {
-        layout_entry(
-            binding,
-            wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-        )
-    };
-    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("synthesis"),
-        entries: &[uniform_entry(0), texture(1), texture(2), texture(3), texture(4)],
-    })
-}
-
 impl<'g> GpuBake<'g> {
     /// Upload `texture` (its exemplar pyramid, F map, priority map and inverse histogram
     /// tables) and build the pipeline; an error names what the port lacks for this texture.
     pub fn new(gpu: &'g Gpu, texture: &TilingBlending) -> Result<Self, GpuError> {
-        let lookup: GpuSynthesis = texture.gpu_synthesis().map_err(GpuError)?;
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let source = wgpu::ShaderModuleDescriptor {
-            label: Some("tiling_blending"),
-            source: wgpu::ShaderSource::Wgsl(wgsl_source().into()),
-        };
-        // wgpu bounds every loop with a hidden counter unless told otherwise; the counter keeps
-        // the compiler from unrolling the loops over the k tiles, whose arrays then live in
-        // local memory: the lookups ran 3 to 8 times slower on an H100 (docs/gpu.md). Bounds
-        // checks and integer division checks stay.
-        let mut checks = wgpu::ShaderRuntimeChecks::checked();
-        checks.force_loop_bounding = false;
-        // SAFETY: without the counter a loop that never ends would hang the GPU. Every loop of
-        // the shaders ends: the loops over tiles, factors and support corners run to constants
-        // (at most 4, 4 and 6: the factor count is checked against MAX_GPU_FACTORS before
-        // upload), and the EWA loops over texel rows and columns are capped at MAX_EWA_SPAN
-        // iterations (mipmap.wgsl), NaN footprints included.
-        #[allow(unsafe_code)]
-        let module = unsafe { device.create_shader_module_trusted(source, checks) };
-        let synthesis_layout = synthesis_layout(gpu);
+        let synthesis = SynthesisGroup::new(gpu, texture)?;
+        let module = shader_module(gpu);
         let storage = wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: false },
             has_dynamic_offset: false,
             min_binding_size: None,
         };
+        let compute = wgpu::ShaderStages::COMPUTE;
         let bake_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bake"),
-            entries: &[uniform_entry(0), layout_entry(1, storage)],
+            entries: &[uniform_entry(0, compute), layout_entry(1, compute, storage)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("bake"),
-            bind_group_layouts: &[Some(&synthesis_layout), Some(&bake_layout)],
+            bind_group_layouts: &[Some(&synthesis.layout), Some(&bake_layout)],
             immediate_size: 0,
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -140,40 +49,15 @@ impl<'g> GpuBake<'g> {
             module: &module,
             entry_point: Some(BAKE_ENTRY_POINT),
             compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &lookup.params.pipeline_constants(),
+                constants: &synthesis.constants,
                 zero_initialize_workgroup_memory: true,
             },
             cache: None,
         });
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("synthesis params"),
-            contents: bytemuck::bytes_of(&lookup.params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let placeholder = Bitmap::new(1, 1, 4);
-        let textures = [
-            upload_mipmap(gpu, "exemplar", Some(lookup.exemplar)),
-            upload_mipmap(gpu, "f map", lookup.f_map),
-            upload_mipmap(gpu, "priority", lookup.priority),
-            upload_pyramid(gpu, "inverse tables", &[lookup.inverse_tables.as_ref().unwrap_or(&placeholder)]),
-        ];
-        let views: Vec<wgpu::TextureView> = textures.iter().map(|t| t.create_view(&Default::default())).collect();
-        let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() }];
-        for (i, view) in views.iter().enumerate() {
-            entries.push(wgpu::BindGroupEntry {
-                binding: i as u32 + 1,
-                resource: wgpu::BindingResource::TextureView(view),
-            });
-        }
-        let synthesis_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("synthesis"),
-            layout: &synthesis_layout,
-            entries: &entries,
-        });
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(GpuError(format!("the GPU refused the tiling-and-blending pipeline: {e}")));
         }
-        Ok(GpuBake { gpu, pipeline, synthesis_group, bake_layout })
+        Ok(GpuBake { gpu, pipeline, synthesis_group: synthesis.group, bake_layout })
     }
 
     /// Rows per band of a bake `width` texels wide: as many as one storage buffer binding
@@ -249,14 +133,6 @@ impl<'g> GpuBake<'g> {
         }
     }
 
-    fn wait(&self) -> Result<(), GpuError> {
-        self.gpu
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError(format!("waiting for the GPU: {e}")))
-    }
-
     /// The RGBA bake at `width` x `height` texel centres, row 0 at the top, as
     /// [`crate::texture::bake_rect`] lays it out.
     pub fn bake(&self, width: u32, height: u32, footprint: BakeFootprint) -> Result<Bitmap, GpuError> {
@@ -282,7 +158,7 @@ impl<'g> GpuBake<'g> {
             encoder.copy_buffer_to_buffer(&output, 0, &readback, 0, bytes);
             self.gpu.queue.submit([encoder.finish()]);
             readback.map_async(wgpu::MapMode::Read, ..bytes, |_| {});
-            self.wait()?;
+            wait(self.gpu)?;
             {
                 let view =
                     readback.get_mapped_range(..bytes).map_err(|e| GpuError(format!("reading the bake back: {e}")))?;
@@ -316,7 +192,7 @@ impl<'g> GpuBake<'g> {
             }
             let start = std::time::Instant::now();
             self.gpu.queue.submit([encoder.finish()]);
-            self.wait()?;
+            wait(self.gpu)?;
             if batch > 0 {
                 seconds.push(start.elapsed().as_secs_f64() / launches as f64);
             }
@@ -329,7 +205,7 @@ impl<'g> GpuBake<'g> {
 mod tests {
     use super::*;
     use crate::texture::tiling_blending::{Blend, Synthesis, Tiling};
-    use crate::texture::{Filter, ImageTexture, Texture};
+    use crate::texture::{Filter, ImageTexture, MipMap, Texture};
     use glam::Vec2;
     use std::sync::Arc;
 

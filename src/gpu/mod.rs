@@ -3,8 +3,11 @@
 //! shaders themselves are [`crate::shader`]'s, which needs no GPU.
 
 mod bake;
+mod synthesis;
+mod view;
 
 pub use bake::GpuBake;
+pub use view::GpuView;
 
 /// Why the GPU could not be used.
 #[derive(Debug, thiserror::Error)]

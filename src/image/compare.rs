@@ -244,6 +244,13 @@ pub struct TexelDifference {
 impl TexelDifference {
     /// Compare `test` with `reference`, keeping the `worst` largest differences.
     pub fn new(test: &Bitmap, reference: &Bitmap, worst: usize) -> Result<Self> {
+        Self::masked(test, reference, &vec![true; test.width * test.height], worst)
+    }
+
+    /// Compare `test` with `reference` at the texels where `mask` is true (row-major, one
+    /// entry per texel; the error image is 0 elsewhere and the means are over the masked
+    /// texels), keeping the `worst` largest differences.
+    pub fn masked(test: &Bitmap, reference: &Bitmap, mask: &[bool], worst: usize) -> Result<Self> {
         if (test.width, test.height, test.channels) != (reference.width, reference.height, reference.channels) {
             return Err(Error::param(
                 "images",
@@ -256,8 +263,17 @@ impl TexelDifference {
         let ch = test.channels;
         let mut max_abs = vec![0.0f32; ch];
         let mut sum = vec![0.0f64; ch];
+        if mask.len() != test.width * test.height {
+            return Err(Error::param(
+                "mask",
+                format!("{} entries for {} texels", mask.len(), test.width * test.height),
+            ));
+        }
         let mut error_image = Bitmap::new(test.width, test.height, 1);
         for (i, (t, r)) in test.data.chunks_exact(ch).zip(reference.data.chunks_exact(ch)).enumerate() {
+            if !mask[i] {
+                continue;
+            }
             let mut texel = 0.0f32;
             for c in 0..ch {
                 let d = (t[c] - r[c]).abs();
@@ -268,8 +284,8 @@ impl TexelDifference {
             }
             error_image.data[i] = texel;
         }
-        let count = (test.width * test.height).max(1) as f64;
-        let mut order: Vec<usize> = (0..error_image.data.len()).collect();
+        let count = mask.iter().filter(|&&m| m).count().max(1) as f64;
+        let mut order: Vec<usize> = (0..error_image.data.len()).filter(|&i| mask[i]).collect();
         let key = |i: usize| if error_image.data[i].is_nan() { f32::INFINITY } else { error_image.data[i] };
         order.sort_by(|&a, &b| key(b).total_cmp(&key(a)).then(a.cmp(&b)));
         let worst = order

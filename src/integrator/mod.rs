@@ -2,6 +2,7 @@
 //! image is bit-identical whatever the number of threads.
 
 mod path;
+pub mod primary;
 
 pub use path::{FirstHit, PathTracer};
 

@@ -123,8 +123,7 @@ impl<'a> PathTracer<'a> {
                 let (dpdx, dpdy) = scene.camera.approximate_dp_dxy(si.p, si.ng);
                 si.set_footprint(dpdx, dpdy);
             }
-            let uv_mirrored = Some(si.dpdu.cross(si.dpdv).dot(si.ng) < 0.0);
-            let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored };
+            let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) };
             let material = &scene.materials[shape.material as usize];
             let bsdf = material.bsdf(&scene.textures, &ctx);
             // Two-sided materials see the back as the front: mirror the local z axis to the
