@@ -77,12 +77,15 @@ fn uv_step(tri: ViewTriangle, dp: vec3<f32>) -> vec2<f32> {
     );
 }
 
-// Where the ray from the eye along `direction` meets the plane n . x = plane, less `p`; zero
-// when it does not (SurfaceInteraction::footprint_from_differential).
-fn step_on_plane(n: vec3<f32>, plane: f32, direction: vec3<f32>, p: vec3<f32>) -> vec3<f32> {
-    let eye = view.eye.xyz;
-    let t = (plane - dot(n, eye)) / dot(n, direction);
-    return select(vec3<f32>(0.0), eye + direction * t - p, is_finite(t));
+// Where the camera ray through the next pixel (direction d + dd, from the eye as the main ray
+// d) meets the plane through `p` with normal `n`, less p (RayDifferential::steps_on_plane:
+// t' = t - k with k = t (n . dd) / (n . (d + dd)), the step dd (t - k) - d k; no difference of
+// nearby points). Zero when the neighbour is parallel to the plane.
+fn step_on_plane(d: vec3<f32>, dd: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let t = dot(p - view.eye.xyz, d) / dot(d, d);
+    let k = (t * dot(n, dd)) / dot(n, d + dd);
+    let step = dd * (t - k) - d * k;
+    return select(vec3<f32>(0.0), step, is_finite(step.x) && is_finite(step.y) && is_finite(step.z));
 }
 
 // The lookup tessera makes where the camera ray through film point `film` (pixels from the
@@ -91,23 +94,19 @@ fn step_on_plane(n: vec3<f32>, plane: f32, direction: vec3<f32>, p: vec3<f32>) -
 fn ray_lookup(tri: ViewTriangle, film: vec2<f32>) -> TexCtx {
     let eye = view.eye.xyz;
     let d = view.corner_direction.xyz + view.pixel_step_x.xyz * film.x + view.pixel_step_y.xyz * film.y;
-    let direction = normalize(d);
     // Barycentric coordinates (Moller and Trumbore 1997).
     let e1 = tri.p1.xyz - tri.p0.xyz;
     let e2 = tri.p2.xyz - tri.p0.xyz;
-    let q = cross(direction, e2);
+    let q = cross(d, e2);
     let s = eye - tri.p0.xyz;
     let b1 = dot(s, q) / dot(e1, q);
-    let b2 = dot(direction, cross(s, e1)) / dot(e1, q);
+    let b2 = dot(d, cross(s, e1)) / dot(e1, q);
     let b0 = 1.0 - b1 - b2;
     let p = tri.p0.xyz * b0 + tri.p1.xyz * b1 + tri.p2.xyz * b2;
     let uv = tri.uv0 * b0 + tri.uv1 * b1 + tri.uv2 * b2;
     let n = tri.ng.xyz;
-    let plane = dot(n, p);
-    let rx = normalize(d + view.pixel_step_x.xyz);
-    let ry = normalize(d + view.pixel_step_y.xyz);
-    let dx = uv_step(tri, step_on_plane(n, plane, rx, p));
-    let dy = uv_step(tri, step_on_plane(n, plane, ry, p));
+    let dx = uv_step(tri, step_on_plane(d, view.pixel_step_x.xyz, p, n));
+    let dy = uv_step(tri, step_on_plane(d, view.pixel_step_y.xyz, p, n));
     return TexCtx(uv, dx, dy, tri.surface);
 }
 

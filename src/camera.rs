@@ -155,12 +155,13 @@ impl PerspectiveCamera {
         let d = self.direction(film);
         let ray = Ray::new(self.position, d.normalize());
         let diff = RayDifferential {
-            rx_o: self.position,
-            rx_d: (d + self.pixel_step[0]).normalize(),
-            ry_o: self.position,
-            ry_d: (d + self.pixel_step[1]).normalize(),
+            d,
+            dx_o: Vec3::ZERO,
+            dx_d: self.pixel_step[0],
+            dy_o: Vec3::ZERO,
+            dy_d: self.pixel_step[1],
         };
-        (ray, diff.scaled(&ray, self.differential_scale))
+        (ray, diff.scaled(self.differential_scale))
     }
 
     fn find_min_direction_step(&self) -> Vec2 {
@@ -194,18 +195,17 @@ impl PerspectiveCamera {
             .try_normalize()
             .unwrap_or_else(|| crate::geometry::Frame::from_normal(dir).s);
         let ey = dir.cross(ex);
-        let plane = n.dot(v);
-        let step = |offset: Vec3| {
-            let d = dir + offset;
-            let denom = n.dot(d);
-            let t = plane / denom;
-            if denom == 0.0 || !t.is_finite() {
-                Vec3::ZERO
-            } else {
-                (self.position + d * t - p) * self.differential_scale
-            }
+        let diff = RayDifferential {
+            d: dir,
+            dx_o: Vec3::ZERO,
+            dx_d: ex * self.min_direction_step.x,
+            dy_o: Vec3::ZERO,
+            dy_d: ey * self.min_direction_step.y,
         };
-        (step(ex * self.min_direction_step.x), step(ey * self.min_direction_step.y))
+        match diff.scaled(self.differential_scale).steps_on_plane(self.position, p, n) {
+            Some(steps) => steps,
+            None => (Vec3::ZERO, Vec3::ZERO),
+        }
     }
 }
 
@@ -273,7 +273,8 @@ mod tests {
         let c = PerspectiveCamera::new(Mat4::IDENTITY, 60.0, FovAxis::Y, 100, 100, 1).unwrap();
         let (ray, diff) = c.generate_ray(Vec2::new(50.0, 50.0));
         let p = ray.at(10.0 / -ray.d.z);
-        let px = diff.rx_o + diff.rx_d * (10.0 / -diff.rx_d.z);
+        let (dx_o, dx_d) = (ray.o + diff.dx_o, diff.d + diff.dx_d);
+        let px = dx_o + dx_d * ((dx_o.z - p.z) / -dx_d.z);
         let (dpdx, dpdy) = c.approximate_dp_dxy(p, Vec3::Z);
         let expected = 10.0 * c.min_direction_step.x;
         assert!((dpdx.length() - expected).abs() < 1e-3 * expected, "{} vs {expected}", dpdx.length());

@@ -14,6 +14,7 @@ pub const SHADER_FILES: &[(&str, &str)] = &[
     ("tiling_blending/tiling.wgsl", include_str!("../shaders/tiling_blending/tiling.wgsl")),
     ("tiling_blending/mipmap.wgsl", include_str!("../shaders/tiling_blending/mipmap.wgsl")),
     ("tiling_blending/deformation.wgsl", include_str!("../shaders/tiling_blending/deformation.wgsl")),
+    ("tiling_blending/cuts.wgsl", include_str!("../shaders/tiling_blending/cuts.wgsl")),
     ("tiling_blending/operators.wgsl", include_str!("../shaders/tiling_blending/operators.wgsl")),
     ("tiling_blending/synthesis.wgsl", include_str!("../shaders/tiling_blending/synthesis.wgsl")),
     ("bake.wgsl", include_str!("../shaders/bake.wgsl")),
@@ -44,6 +45,34 @@ pub enum ShaderLanguage {
     Msl,
 }
 
+/// Which shader to export.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShaderEntry {
+    /// The compute bake of the UV square (`bake.wgsl`).
+    Bake,
+    /// The rasterised view (`view.wgsl`): its fragment shader, the lookup an engine's material
+    /// makes (GLSL holds one stage per file); HLSL, MSL and WGSL hold its vertex shader too.
+    View,
+}
+
+impl ShaderEntry {
+    /// The entry point GLSL gets, and its stage.
+    fn glsl_stage(self) -> (naga::ShaderStage, &'static str) {
+        match self {
+            ShaderEntry::Bake => (naga::ShaderStage::Compute, BAKE_ENTRY_POINT),
+            ShaderEntry::View => (naga::ShaderStage::Fragment, VIEW_ENTRY_POINTS.1),
+        }
+    }
+
+    /// The entry points an export keeps.
+    fn entry_points(self) -> &'static [&'static str] {
+        match self {
+            ShaderEntry::Bake => &[BAKE_ENTRY_POINT],
+            ShaderEntry::View => &[VIEW_ENTRY_POINTS.0, VIEW_ENTRY_POINTS.1],
+        }
+    }
+}
+
 /// Why the shaders could not be parsed, validated or translated.
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
@@ -60,10 +89,15 @@ pub fn module() -> Result<(naga::Module, naga::valid::ModuleInfo), ShaderError> 
     Ok((module, info))
 }
 
-/// The bake entry point's shader in `language`, general (the specialising pipeline constants
-/// of `params.wgsl` at their defaults: the uniform block decides).
-pub fn export(language: ShaderLanguage) -> Result<String, ShaderError> {
-    let (module, info) = module()?;
+/// The shader of `entry` in `language`, general (the specialising pipeline constants of
+/// `params.wgsl` at their defaults: the uniform block decides), with the functions it calls.
+pub fn export(language: ShaderLanguage, entry: ShaderEntry) -> Result<String, ShaderError> {
+    let (mut module, _) = module()?;
+    // Keep only the entry points exported; naga's back ends then write what they reach.
+    module.entry_points.retain(|e| entry.entry_points().contains(&e.name.as_str()));
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
+        .map_err(|e| ShaderError(format!("WGSL validation error: {e}")))?;
     let (module, info) = naga::back::pipeline_constants::process_overrides(
         &module,
         &info,
@@ -92,11 +126,9 @@ pub fn export(language: ShaderLanguage) -> Result<String, ShaderError> {
                 binding_map,
                 zero_initialize_workgroup_memory: true,
             };
-            let pipeline = naga::back::glsl::PipelineOptions {
-                shader_stage: naga::ShaderStage::Compute,
-                entry_point: BAKE_ENTRY_POINT.into(),
-                multiview: None,
-            };
+            let (shader_stage, entry_point) = entry.glsl_stage();
+            let pipeline =
+                naga::back::glsl::PipelineOptions { shader_stage, entry_point: entry_point.into(), multiview: None };
             let mut out = String::new();
             let mut writer = naga::back::glsl::Writer::new(
                 &mut out,
@@ -112,9 +144,7 @@ pub fn export(language: ShaderLanguage) -> Result<String, ShaderError> {
         }
         ShaderLanguage::Hlsl => {
             let options = naga::back::hlsl::Options::default();
-            let pipeline = naga::back::hlsl::PipelineOptions {
-                entry_point: Some((naga::ShaderStage::Compute, BAKE_ENTRY_POINT.into())),
-            };
+            let pipeline = naga::back::hlsl::PipelineOptions { entry_point: None };
             let mut out = String::new();
             naga::back::hlsl::Writer::new(&mut out, &options, &pipeline)
                 .write(&module, &info, None)
@@ -123,10 +153,7 @@ pub fn export(language: ShaderLanguage) -> Result<String, ShaderError> {
         }
         ShaderLanguage::Msl => {
             let options = naga::back::msl::Options { lang_version: (2, 0), ..Default::default() };
-            let pipeline = naga::back::msl::PipelineOptions {
-                entry_point: Some((naga::ShaderStage::Compute, BAKE_ENTRY_POINT.into())),
-                ..Default::default()
-            };
+            let pipeline = naga::back::msl::PipelineOptions::default();
             naga::back::msl::write_string(&module, &info, &options, &pipeline)
                 .map(|(text, _)| text)
                 .map_err(|e| failed("MSL", &e))
@@ -138,7 +165,9 @@ pub fn export(language: ShaderLanguage) -> Result<String, ShaderError> {
 mod tests {
     use super::*;
     use crate::integrator::primary::{Derivatives, ViewParams, ViewTriangle};
-    use crate::texture::tiling_blending::params::{FactorParams, ImageParams, SynthesisParams};
+    use crate::texture::tiling_blending::params::{
+        CutCurveParams, CutPointParams, FactorParams, ImageParams, SynthesisParams,
+    };
     use std::mem::{offset_of, size_of};
 
     #[test]
@@ -167,7 +196,7 @@ mod tests {
     fn the_parameter_block_has_the_same_layout_on_both_sides() {
         let (module, _) = module().unwrap();
         let expected = [
-            ("ImageParams", rust_layout!(ImageParams { filtering, levels, scale, offset, padding })),
+            ("ImageParams", rust_layout!(ImageParams { filtering, levels, scale, offset, gradient_scale, padding })),
             ("FactorParams", rust_layout!(FactorParams { kind, padding, values })),
             (
                 "SynthesisParams",
@@ -183,9 +212,16 @@ mod tests {
                     exemplar,
                     priority,
                     factors,
+                    cuts,
+                    padding,
                 }),
             ),
             ("BakeParams", rust_layout!(crate::texture::BakeParams { width, height, footprint, first_row })),
+            ("CutPointParams", rust_layout!(CutPointParams { uv0, uv1, g, s, padding })),
+            (
+                "CutCurveParams",
+                rust_layout!(CutCurveParams { first_point, point_count, first_anchor, anchor_count, spacing, padding }),
+            ),
             (
                 "ViewParams",
                 rust_layout!(ViewParams { clip_from_world, eye, corner_direction, pixel_step_x, pixel_step_y }),
@@ -217,6 +253,7 @@ mod tests {
             ("FILTER_NONE", FILTER_NONE),
             ("FILTER_TRILINEAR", FILTER_TRILINEAR),
             ("FILTER_EWA", FILTER_EWA),
+            ("FILTER_HARDWARE", FILTER_HARDWARE),
             ("TILING_HEXAGONAL", TILING_HEXAGONAL),
             ("TILING_SQUARE", TILING_SQUARE),
             ("BLEND_LINEAR", BLEND_LINEAR),
@@ -235,6 +272,9 @@ mod tests {
             ("MAX_DEFORMATION", crate::texture::tiling_blending::MAX_DEFORMATION.to_bits()),
             ("SURFACE_UNMIRRORED", crate::integrator::primary::SURFACE_UNMIRRORED),
             ("SURFACE_MIRRORED", crate::integrator::primary::SURFACE_MIRRORED),
+            ("CUT_SALT", crate::texture::tiling_blending::CUT_SALT),
+            ("CUT_SEARCH", crate::texture::tiling_blending::CUT_SEARCH as u32),
+            ("BANDS_PER_POINT", crate::texture::tiling_blending::BANDS_PER_POINT as u32),
             ("DERIVATIVES_DPDX", Derivatives::Dpdx.code()),
             ("DERIVATIVES_COARSE", Derivatives::Coarse.code()),
             ("DERIVATIVES_FINE", Derivatives::Fine.code()),
@@ -247,8 +287,19 @@ mod tests {
     #[test]
     fn every_language_exports() {
         for language in [ShaderLanguage::Wgsl, ShaderLanguage::Glsl, ShaderLanguage::Hlsl, ShaderLanguage::Msl] {
-            let text = export(language).unwrap_or_else(|e| panic!("{language:?}: {e}"));
-            assert!(text.len() > 1000, "{language:?}: {} bytes", text.len());
+            for entry in [ShaderEntry::Bake, ShaderEntry::View] {
+                let text = export(language, entry).unwrap_or_else(|e| panic!("{language:?} {entry:?}: {e}"));
+                assert!(text.len() > 1000, "{language:?} {entry:?}: {} bytes", text.len());
+                // Each export holds its own entry points and not the other's.
+                let (has, lacks) = match entry {
+                    ShaderEntry::Bake => (BAKE_ENTRY_POINT, VIEW_ENTRY_POINTS.1),
+                    ShaderEntry::View => (VIEW_ENTRY_POINTS.1, BAKE_ENTRY_POINT),
+                };
+                if language != ShaderLanguage::Glsl {
+                    assert!(text.contains(has), "{language:?} {entry:?} lacks {has}");
+                }
+                assert!(!text.contains(&format!("{lacks}(")), "{language:?} {entry:?} holds {lacks}");
+            }
         }
     }
 }

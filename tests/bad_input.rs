@@ -401,6 +401,19 @@ fn gpu_commands_name_what_is_wrong() {
     assert!(stderr_of(&["gpu-check", scene, "--texture", "e"]).contains("not a tiling_blending texture"));
     assert!(stderr_of(&["gpu-check", scene, "--texture", "tb", "--tolerance", "NaN"]).contains("--tolerance"));
     assert!(stderr_of(&["gpu-check", scene, "--texture", "nope"]).contains("unknown texture 'nope'"));
+    assert!(stderr_of(&["gpu-view", scene, "--texture", "e"]).contains("not a tiling_blending texture"));
+    assert!(stderr_of(&["gpu-view", scene, "--texture", "tb", "--tolerance", "-1"]).contains("--tolerance"));
+    let msg = stderr_of(&["gpu-view", scene, "--texture", "tb", "-o", "view.txt"]);
+    assert!(msg.contains("view.txt"), "{msg}");
+    // Sizes clap refuses (exit status 2), saying why.
+    for (res, why) in
+        [("0x10", "outside"), ("640", "WIDTHxHEIGHT"), ("99999x99999", "outside"), ("8000x8000", "more than")]
+    {
+        let out = tessera().args(["gpu-view", scene, "--texture", "tb", "--res", res]).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{res}");
+        let msg = String::from_utf8_lossy(&out.stderr);
+        assert!(msg.contains(why), "{res}: {msg}");
+    }
     // The shader export writes atomically: a folder that does not exist is an error naming it.
     let missing = dir.path().join("no/such/folder/t.glsl");
     let msg = stderr_of(&["shader", "export", "--lang", "glsl", "-o", missing.to_str().unwrap()]);

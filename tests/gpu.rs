@@ -157,7 +157,10 @@ fn every_configuration_matches_the_cpu_bake() {
 #[test]
 fn shipped_scenes_match_the_cpu_bake() {
     let gpu = gpu();
-    let scenes = ["fig2_rotation", "fig2_scaling", "fig2_shearing", "brushed_tb", "pbr_rocks", "fig4/fig4"];
+    // sphere_deformed's `deformed` texture has the cut bands `tessera deform` derived from a
+    // lat-long sphere's seam.
+    let scenes =
+        ["fig2_rotation", "fig2_scaling", "fig2_shearing", "brushed_tb", "pbr_rocks", "fig4/fig4", "sphere_deformed"];
     let mut checked = 0;
     for name in scenes {
         let path = common::repo().join(format!("scenes/{name}.toml"));
@@ -175,7 +178,7 @@ fn shipped_scenes_match_the_cpu_bake() {
             checked += 1;
         }
     }
-    assert!(checked >= 8, "only {checked} textures checked");
+    assert!(checked >= 10, "only {checked} textures checked");
 }
 
 #[test]
@@ -203,23 +206,26 @@ fn gpu_bakes_are_deterministic() {
 /// glslang-tools), as an engine's build would.
 #[test]
 fn exported_glsl_compiles_with_glslang() {
-    let glsl = tessera::shader::export(tessera::shader::ShaderLanguage::Glsl).unwrap();
+    use tessera::shader::{ShaderEntry, ShaderLanguage, export};
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("tiling_blending.comp");
-    std::fs::write(&path, glsl).unwrap();
-    let output = std::process::Command::new("glslangValidator")
-        .arg("-V")
-        .arg(&path)
-        .arg("-o")
-        .arg(dir.path().join("tiling_blending.spv"))
-        .output()
-        .unwrap_or_else(|e| panic!("glslangValidator (Debian glslang-tools) is needed: {e}"));
-    assert!(
-        output.status.success(),
-        "glslangValidator rejected the exported GLSL:\n{}{}",
-        String::from_utf8_lossy(&output.stdout),
-        String::from_utf8_lossy(&output.stderr)
-    );
+    // glslangValidator takes the stage from the extension.
+    for (entry, file) in [(ShaderEntry::Bake, "bake.comp"), (ShaderEntry::View, "view.frag")] {
+        let path = dir.path().join(file);
+        std::fs::write(&path, export(ShaderLanguage::Glsl, entry).unwrap()).unwrap();
+        let output = std::process::Command::new("glslangValidator")
+            .arg("-V")
+            .arg(&path)
+            .arg("-o")
+            .arg(dir.path().join(format!("{file}.spv")))
+            .output()
+            .unwrap_or_else(|e| panic!("glslangValidator (Debian glslang-tools) is needed: {e}"));
+        assert!(
+            output.status.success(),
+            "glslangValidator rejected the exported GLSL of {entry:?}:\n{}{}",
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
 }
 
 /// Histogram preservation reads T^-1 from a table: where the exemplar's histogram has a gap, the
@@ -312,7 +318,7 @@ fn the_rasterised_view_with_ray_differentials_matches_tessera() {
         let deformation = deformations()[deformation].1.clone();
         let synthesis = Synthesis { tiling, tile_size: 0.23, seed: 3, deformation, cuts: None, blend, inset: false };
         let texture = TilingBlending::new(Arc::new(synthesis), exemplar).unwrap();
-        let on_gpu = GpuView::new(&gpu, &scene, &camera, &texture)
+        let on_gpu = GpuView::new(&gpu, &scene, &camera, &texture, None)
             .and_then(|view| view.render(Derivatives::Ray))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let on_cpu = primary_view(&scene, &camera, &Texture::TilingBlending(texture));
@@ -333,7 +339,7 @@ fn the_rasterised_view_with_ray_differentials_matches_tessera() {
         // quad's is not (its u runs right to left as well).
         assert!(mirrored_seen > 200 && seen - mirrored_seen > 200, "{name}: {mirrored_seen} of {seen} mirrored");
         assert!(diff.value.within(TOLERANCE), "{name}: {:?}", diff.value.worst);
-        assert!(diff.footprint.max < 1e-3, "{name}: footprint error {:?}", diff.footprint);
+        assert!(diff.footprint.max < 1e-4, "{name}: footprint error {:?}", diff.footprint);
     }
 }
 
@@ -365,7 +371,7 @@ fn screen_space_derivatives_are_exact_where_uv_is_affine_on_the_screen() {
     let gpu = gpu();
     let exemplar = Arc::new(Texture::Image(image(exemplar_image(), Filter::Trilinear)));
     let texture = hexagonal(exemplar, Blend::Linear, deformations()[5].1.clone(), 2);
-    let view = GpuView::new(&gpu, &scene, &camera, &texture).unwrap();
+    let view = GpuView::new(&gpu, &scene, &camera, &texture, None).unwrap();
     let on_cpu = primary_view(&scene, &camera, &Texture::TilingBlending(texture));
     for derivatives in [Derivatives::Dpdx, Derivatives::Coarse, Derivatives::Fine] {
         let diff = ViewDifference::new(&view.render(derivatives).unwrap(), &on_cpu, 3).unwrap();
@@ -376,6 +382,100 @@ fn screen_space_derivatives_are_exact_where_uv_is_affine_on_the_screen() {
             diff.value.max()
         );
         assert!(diff.compared > 1000, "{diff:?}");
-        assert!(diff.footprint.max < 1e-3, "{}: {:?}", derivatives.name(), diff.footprint);
+        assert!(diff.footprint.max < 1e-4, "{}: {:?}", derivatives.name(), diff.footprint);
     }
+}
+
+#[test]
+fn hardware_bilinear_sampling_is_within_the_bound_of_fixed_point_weights() {
+    use tessera::texture::tiling_blending::params::HardwareSampling;
+    // Regime (b) with point lookups: the texture unit filters level 0 bilinearly, with weights
+    // in fixed point (8 fractional bits on NVIDIA, AMD and Intel GPUs; lavapipe computes them
+    // in f32). A weight off by at most 2^-8 per axis moves a value by at most 2^-8 of the
+    // largest difference between neighbouring texels per axis, and linear blending of tiles
+    // (weights summing to 1) keeps that bound.
+    let bitmap = exemplar_image();
+    let mut contrast = 0.0f32;
+    for y in 0..bitmap.height {
+        for x in 0..bitmap.width {
+            let p = bitmap.pixel(x, y);
+            let right = bitmap.pixel((x + 1) % bitmap.width, y);
+            let down = bitmap.pixel(x, (y + 1) % bitmap.height);
+            contrast = contrast.max((right - p).abs().max_element()).max((down - p).abs().max_element());
+        }
+    }
+    let gpu = gpu();
+    let exemplar = Arc::new(Texture::Image(image(bitmap, Filter::Trilinear)));
+    let texture = hexagonal(exemplar, Blend::Linear, deformations()[5].1.clone(), 4);
+    let sampling = HardwareSampling { anisotropy: 1, gradient_scale: 1.0 };
+    let baker = GpuBake::with_sampling(&gpu, &texture, Some(sampling)).unwrap_or_else(|e| panic!("{e}"));
+    let on_gpu = baker.bake(64, 48, BakeFootprint::Point).unwrap();
+    let on_cpu = bake_rect(&Texture::TilingBlending(texture), 64, 48, BakeFootprint::Point);
+    let diff = TexelDifference::new(&on_gpu, &on_cpu, 3).unwrap();
+    let bound = 2.0 * contrast / 256.0;
+    eprintln!(
+        "hardware bilinear: max |gpu - cpu| {:.2e}, bound {bound:.2e} (texel contrast {contrast:.3})",
+        diff.max()
+    );
+    assert!(diff.within(bound), "{:?}", diff.worst);
+}
+
+#[test]
+fn cut_bands_match_the_cpu_bake() {
+    use tessera::texture::tiling_blending::{CutBands, CutCurve, CutPoint};
+    // Two cuts of the F map's square: a straight one seen at u = 0.3 and u = 0.7 (g along its
+    // length), and a bent one crossing it, so that points lie in two bands at once.
+    let straight = (0..=8)
+        .map(|k| {
+            let v = k as f32 / 8.0;
+            CutPoint { uv: [Vec2::new(0.3, v), Vec2::new(0.7, 1.0 - v)], s: v, g: Vec2::new(v, 0.1 * v) }
+        })
+        .collect();
+    let bent = (0..=6)
+        .map(|k| {
+            let t = k as f32 / 6.0;
+            let a = Vec2::new(0.1 + 0.8 * t, 0.5 + 0.2 * (3.0 * t).sin());
+            CutPoint { uv: [a, a + Vec2::new(0.0, 0.1)], s: 0.9 * t, g: Vec2::new(0.0, 0.9 * t) }
+        })
+        .collect();
+    let curves = vec![CutCurve::new(straight, 1.3).unwrap(), CutCurve::new(bent, 0.8).unwrap()];
+    let map = f_map();
+    // The bands cover a good part of the square (and so of the bakes below).
+    let bands = CutBands::new(curves.clone(), map.level(0), 0.12).unwrap();
+    let near = (0..64 * 64).filter(|i| bands.near((Vec2::new((i % 64) as f32, (i / 64) as f32) + 0.5) / 64.0)).count();
+    assert!(near > 64 * 64 / 4, "{near} of {} texels near a cut", 64 * 64);
+    let gpu = gpu();
+    let mut failures = Vec::new();
+    for (blend_name, blend) in blends(Filter::Trilinear) {
+        for inset in [false, true] {
+            let tile_size = 0.12;
+            let bands = CutBands::new(curves.clone(), map.level(0), tile_size).unwrap();
+            let exemplar = Arc::new(Texture::Image(image(exemplar_image(), Filter::Trilinear)));
+            let deformation = Some(DeformationField::new(vec![
+                Deformation::Map(f_map()),
+                Deformation::Rotation { angle: 0.2, gradient: Vec2::ZERO },
+            ]));
+            let synthesis = Synthesis {
+                tiling: Tiling::Square,
+                tile_size,
+                seed: 5,
+                deformation,
+                cuts: Some(bands),
+                blend: blend.clone(),
+                inset,
+            };
+            let texture = TilingBlending::new(Arc::new(synthesis), exemplar).unwrap();
+            for footprint in [BakeFootprint::Texel, BakeFootprint::Point] {
+                let diff = compare(&gpu, &texture, 64, 64, footprint);
+                if !diff.within(TOLERANCE) {
+                    failures.push(format!(
+                        "{blend_name}, inset {inset}, {footprint:?}: {:.2e} {:?}",
+                        diff.max(),
+                        diff.worst
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -75,3 +75,14 @@ fn deformation_on_surface(uv: vec2<f32>, surface: u32) -> mat2x2<f32> {
 fn deformation_at(uv: vec2<f32>) -> mat2x2<f32> {
     return deformation_on_surface(uv, SURFACE_NONE);
 }
+
+// The F map factor at `uv`, mirrored as deformation_on_surface mirrors it
+// (DeformationField::map_at): the field whose units cut bands measure in. Zero without a map.
+fn map_on_surface(uv: vec2<f32>, surface: u32) -> mat2x2<f32> {
+    for (var i = 0u; i < factor_count(); i++) {
+        if factor_kind(i) == FACTOR_MAP {
+            return with_handedness(bounded(factor_at(FACTOR_MAP, synthesis.factors[i], uv)), surface);
+        }
+    }
+    return mat2x2<f32>(0.0, 0.0, 0.0, 0.0);
+}

@@ -46,6 +46,7 @@ fn bilinear(image: texture_2d<f32>, level: u32, st: vec2<f32>) -> vec4<f32> {
 const FILTER_NONE: u32 = 0u;
 const FILTER_TRILINEAR: u32 = 1u;
 const FILTER_EWA: u32 = 2u;
+const FILTER_HARDWARE: u32 = 3u;
 // Longest-to-shortest axis ratio beyond which the EWA ellipse is widened.
 const MAX_ANISOTROPY: f32 = 8.0;
 // Nodes of the Gaussian EWA weight table.
@@ -106,6 +107,13 @@ fn filter_lod(image: texture_2d<f32>, params: ImageParams, filtering: u32, dst0:
                 return width_lod(params, axes.shorter);
             }
             return 0.0;
+        }
+        case FILTER_HARDWARE: {
+            // The isotropic level of detail of the WGSL specification: log2 of the longer
+            // footprint axis in texels.
+            let size = vec2<f32>(textureDimensions(image, 0u));
+            let g = params.gradient_scale;
+            return width_lod(params, g * max(length(dst0 * size), length(dst1 * size)));
         }
         default: {
             return 0.0;
@@ -202,6 +210,10 @@ fn mip_lookup(image: texture_2d<f32>, params: ImageParams, filtering: u32, st_in
         }
         case FILTER_EWA: {
             return ewa(image, params, st, dst0, dst1);
+        }
+        case FILTER_HARDWARE: {
+            let g = params.gradient_scale;
+            return textureSampleGrad(image, hardware_sampler, st, dst0 * g, dst1 * g);
         }
         default: {
             return bilinear(image, 0u, st);

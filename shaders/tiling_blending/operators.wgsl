@@ -29,9 +29,10 @@ fn win_probability(difference: f32, variance: f32) -> f32 {
 }
 
 // The tiles' blending weights: the paving's, or Mix-Max's duels, normalised.
-fn blend_weights(lookups: Lookups) -> array<f32, 4> {
-    var w: array<f32, 4>;
-    for (var i = 0u; i < tile_count(); i++) {
+fn blend_weights(lookups: Lookups) -> array<f32, 8> {
+    let n = lookup_count(lookups);
+    var w: array<f32, 8>;
+    for (var i = 0u; i < n; i++) {
         w[i] = lookups.lookup[i].weight;
     }
     if blend_code() != BLEND_MIX_MAX {
@@ -39,9 +40,9 @@ fn blend_weights(lookups: Lookups) -> array<f32, 4> {
     }
     let contrast = synthesis.mix_max.x;
     let lambda = synthesis.mix_max.y;
-    var score: array<f32, 4>;
-    var variance: array<f32, 4>;
-    for (var i = 0u; i < tile_count(); i++) {
+    var score: array<f32, 8>;
+    var variance: array<f32, 8>;
+    for (var i = 0u; i < n; i++) {
         score[i] = NEG_INFINITY;
         variance[i] = 0.0;
         if lookups.lookup[i].weight > 0.0 {
@@ -50,13 +51,13 @@ fn blend_weights(lookups: Lookups) -> array<f32, 4> {
             variance[i] = contrast * contrast * max(v.w - v.x * v.x, 0.0);
         }
     }
-    var mixed: array<f32, 4>;
+    var mixed: array<f32, 8>;
     var sum = 0.0;
-    for (var i = 0u; i < tile_count(); i++) {
+    for (var i = 0u; i < n; i++) {
         mixed[i] = 0.0;
         if lookups.lookup[i].weight > 0.0 {
             var p = 1.0;
-            for (var j = 0u; j < tile_count(); j++) {
+            for (var j = 0u; j < n; j++) {
                 if j != i && lookups.lookup[j].weight > 0.0 {
                     p *= win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda);
                 }
@@ -66,7 +67,7 @@ fn blend_weights(lookups: Lookups) -> array<f32, 4> {
         sum += mixed[i];
     }
     if sum > 0.0 {
-        for (var i = 0u; i < tile_count(); i++) {
+        for (var i = 0u; i < n; i++) {
             mixed[i] /= sum;
         }
         return mixed;
@@ -75,11 +76,11 @@ fn blend_weights(lookups: Lookups) -> array<f32, 4> {
     return w;
 }
 
-// m + sum w_i (v_i - m) / sqrt(sum w_i^2).
-fn variance_preserving(w: array<f32, 4>, values: array<vec4<f32>, 4>, mean: vec4<f32>) -> vec4<f32> {
+// m + sum w_i (v_i - m) / sqrt(sum w_i^2) over the first n lookups.
+fn variance_preserving(w: array<f32, 8>, values: array<vec4<f32>, 8>, mean: vec4<f32>, n: u32) -> vec4<f32> {
     var norm2 = 0.0;
     var deviation = vec4<f32>(0.0);
-    for (var i = 0u; i < tile_count(); i++) {
+    for (var i = 0u; i < n; i++) {
         norm2 += w[i] * w[i];
         deviation += (values[i] - mean) * w[i];
     }

@@ -18,13 +18,15 @@ const FACTOR_MAP: u32 = 4u;
 
 const MAX_GPU_FACTORS: u32 = 4u;
 
-// How an image is read: filter 0 bilinear at the finest level, 1 trilinear; uv * scale + offset.
+// How an image is read: a FILTER_* code (mipmap.wgsl), its level count, uv * scale + offset,
+// and for FILTER_HARDWARE the factor the footprint is scaled by before textureSampleGrad.
 struct ImageParams {
     filtering: u32,
     levels: u32,
     scale: vec2<f32>,
     offset: vec2<f32>,
-    padding: vec2<u32>,
+    gradient_scale: f32,
+    padding: u32,
 }
 
 // One factor of the deformation field; `values` by kind as params.rs documents.
@@ -46,6 +48,8 @@ struct SynthesisParams {
     exemplar: ImageParams,
     priority: ImageParams,
     factors: array<FactorParams, 4>,
+    cuts: u32,
+    @size(12) padding: u32,
 }
 
 @group(0) @binding(0) var<uniform> synthesis: SynthesisParams;
@@ -63,6 +67,7 @@ override FACTOR0_KIND: u32 = ANY;
 override FACTOR1_KIND: u32 = ANY;
 override FACTOR2_KIND: u32 = ANY;
 override FACTOR3_KIND: u32 = ANY;
+override CUTS: u32 = ANY;
 
 fn specialised(constant: u32, uniform: u32) -> u32 {
     return select(constant, uniform, constant == ANY);
@@ -90,6 +95,11 @@ fn priority_filtering() -> u32 {
     return specialised(PRIORITY_FILTERING, synthesis.priority.filtering);
 }
 
+// Whether the synthesis has cut bands (cuts.wgsl).
+fn cuts_enabled() -> bool {
+    return specialised(CUTS, synthesis.cuts) != 0u;
+}
+
 fn factor_count() -> u32 {
     return specialised(FACTOR_COUNT, synthesis.factor_count);
 }
@@ -106,6 +116,8 @@ fn factor_kind(i: u32) -> u32 {
 @group(0) @binding(3) var priority_image: texture_2d<f32>;
 // The inverse histogram tables: row L the tables of MIP level L, texel i at g = i / (width - 1).
 @group(0) @binding(4) var inverse_tables_image: texture_2d<f32>;
+// The sampler of FILTER_HARDWARE lookups: trilinear, repeat, anisotropic as tessera sets it.
+@group(0) @binding(5) var hardware_sampler: sampler;
 
 // Whether the surface a lookup is on has its UV map mirrored (TexCtx::uv_mirrored on the CPU):
 // unknown without a surface (a bake of the UV square), or known from the sign of

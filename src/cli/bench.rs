@@ -484,6 +484,7 @@ fn pups(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
 #[cfg(feature = "gpu")]
 fn gpu(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
     use tessera::gpu::{Gpu, GpuBake};
+    use tessera::texture::tiling_blending::{CutBands, CutCurve, CutPoint};
     use tessera::texture::{BakeFootprint, bake_rect};
     let device = Gpu::new().map_err(|e| Error::param("gpu", e.0))?;
     // A 1024 x 1024 RGBA exemplar of uniform noise, as the yardstick's.
@@ -504,25 +505,37 @@ fn gpu(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         let f = Mat2::from_angle(1.5 * (i % m) as f32 / (m - 1) as f32) * 1.3;
         px.copy_from_slice(&[f.x_axis.x, f.y_axis.x, f.x_axis.y, f.y_axis.y]);
     }
+    // Cut bands along a cut seen at u = 1/4 and u = 3/4 (the bands cover about a sixth of the
+    // square).
+    let seam = (0..=16)
+        .map(|k| {
+            let v = k as f32 / 16.0;
+            CutPoint { uv: [Vec2::new(0.25, v), Vec2::new(0.75, v)], s: v, g: Vec2::new(0.0, v) }
+        })
+        .collect();
+    let seam = CutCurve::new(seam, 1.3).map_err(|e| Error::param("bench", e))?;
+    let cuts = CutBands::new(vec![seam], &map, 0.036_084_39).map_err(|e| Error::param("bench", e))?;
     let deformation = DeformationField::new(vec![Deformation::Map(MipMap::new(map))]);
     let Texture::Image(plain) = exemplar(Filter::None).as_ref().clone() else { unreachable!("an image") };
     let mix_max = Blend::MixMax { priority: PriorityMap::new(&plain), contrast: 4.0, lambda: 0.05 };
+    let d = Some(deformation.clone());
     let cases = [
-        ("classical, linear", None, Blend::Linear, Filter::None, BakeFootprint::Point),
-        ("deformed, linear", Some(deformation.clone()), Blend::Linear, Filter::None, BakeFootprint::Point),
-        ("deformed, mix-max", Some(deformation.clone()), mix_max, Filter::None, BakeFootprint::Point),
-        ("deformed, linear, EWA", Some(deformation.clone()), Blend::Linear, Filter::Ewa, BakeFootprint::Texel),
+        ("classical, linear", None, None, Blend::Linear, Filter::None, BakeFootprint::Point),
+        ("deformed, linear", d.clone(), None, Blend::Linear, Filter::None, BakeFootprint::Point),
+        ("deformed, mix-max", d.clone(), None, mix_max, Filter::None, BakeFootprint::Point),
+        ("deformed, linear, EWA", d.clone(), None, Blend::Linear, Filter::Ewa, BakeFootprint::Texel),
+        ("deformed, linear, cut", d, Some(cuts), Blend::Linear, Filter::None, BakeFootprint::Point),
     ];
     println!("gpu        {}", device.describe());
     println!("           CPU: 512 x 512 bakes on {} threads", pool.current_num_threads());
-    for (name, deformation, blend, filter, footprint) in cases {
+    for (name, deformation, cuts, blend, filter, footprint) in cases {
         // The yardstick's lattice: spacing 1 / (8 sqrt 12) in UV.
         let synthesis = Synthesis {
             tiling: Tiling::Hexagonal,
             tile_size: 0.036_084_39,
             seed: 1,
             deformation,
-            cuts: None,
+            cuts,
             blend,
             inset: false,
         };
@@ -601,7 +614,7 @@ fn gpu_view(
         inset: false,
     };
     let texture = TilingBlending::new(Arc::new(synthesis), exemplar).map_err(|e| Error::param("bench", e))?;
-    let view = GpuView::new(device, &scene, &scene.camera, &texture).map_err(|e| Error::param("gpu", e.0))?;
+    let view = GpuView::new(device, &scene, &scene.camera, &texture, None).map_err(|e| Error::param("gpu", e.0))?;
     for derivatives in [Derivatives::Dpdx, Derivatives::Ray] {
         let probe = median(view.time(derivatives, 1, 1).map_err(|e| Error::param("gpu", e.0))?);
         let frames = ((0.2 / probe) as usize).clamp(1, 200);

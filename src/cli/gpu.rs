@@ -7,19 +7,27 @@ use std::process::ExitCode;
 use tessera::error::{Error, Result};
 use tessera::image::Bitmap;
 use tessera::image::compare::TexelDifference;
-use tessera::integrator::primary::{Derivatives, PrimaryView, ViewDifference, primary_view};
-use tessera::shader::{ShaderLanguage, export};
+use tessera::integrator::primary::{
+    Derivatives, ErrorQuantiles, PrimaryView, ViewDifference, primary_view, ulp_sensitivity,
+};
+use tessera::shader::{ShaderEntry, ShaderLanguage, export};
+use tessera::texture::tiling_blending::params::HardwareSampling;
 use tessera::texture::{BakeFootprint, Texture, bake};
 
 /// `tessera shader ...`.
 #[derive(clap::Subcommand)]
 pub enum ShaderCommand {
-    /// Write the tiling-and-blending shader (its bake compute entry point and every function
-    /// it calls) in a shading language, translated from the WGSL by naga.
+    /// Write the tiling-and-blending shader (the bake's compute shader or the view's fragment
+    /// shader, and every function it calls) in a shading language, translated from the WGSL by
+    /// naga.
     Export {
         /// The language.
         #[arg(long, value_enum, default_value = "wgsl")]
         lang: ShaderLanguage,
+        /// Which shader: the compute bake of the UV square, or the rasterised view (its fragment
+        /// shader: the lookup with screen-space derivatives or ray differentials).
+        #[arg(long, value_enum, default_value = "bake")]
+        entry: ShaderEntry,
         /// Output file (default: standard output).
         #[arg(short, long)]
         output: Option<PathBuf>,
@@ -29,8 +37,8 @@ pub enum ShaderCommand {
 /// Run `tessera shader ...`.
 pub fn shader(command: ShaderCommand) -> Result<()> {
     match command {
-        ShaderCommand::Export { lang, output } => {
-            let text = export(lang).map_err(|e| Error::param("shader", e.0))?;
+        ShaderCommand::Export { lang, entry, output } => {
+            let text = export(lang, entry).map_err(|e| Error::param("shader", e.0))?;
             match output {
                 Some(path) => tessera::files::write_atomically(&path, |tmp| {
                     std::fs::write(tmp, &text).map_err(|e| Error::io(tmp, e))
@@ -58,19 +66,49 @@ fn gpu_error(e: tessera::gpu::GpuError) -> Error {
     Error::param("gpu", e.0)
 }
 
-/// The GPU bake of `texture` at `res` x `res` on the first adapter, and that adapter's name.
+/// The GPU bakes of `texture` at `res` x `res` on the first adapter, one per way of reading the
+/// exemplar (`samplings`: None the shader's f32 filters, Some the texture unit), and that
+/// adapter's name.
 #[cfg(feature = "gpu")]
-pub fn bake_on_gpu(texture: &Texture, name: &str, res: u32, footprint: BakeFootprint) -> Result<(Bitmap, String)> {
+pub fn bake_on_gpu(
+    texture: &Texture,
+    name: &str,
+    res: u32,
+    footprint: BakeFootprint,
+    samplings: &[Option<HardwareSampling>],
+) -> Result<(Vec<Bitmap>, String)> {
+    let texture = tiling_blending(texture, name)?;
     let gpu = tessera::gpu::Gpu::new().map_err(gpu_error)?;
-    let baker = tessera::gpu::GpuBake::new(&gpu, tiling_blending(texture, name)?).map_err(gpu_error)?;
-    Ok((baker.bake(res, res, footprint).map_err(gpu_error)?, gpu.describe()))
+    let bakes = samplings
+        .iter()
+        .map(|&sampling| {
+            let baker = tessera::gpu::GpuBake::with_sampling(&gpu, texture, sampling).map_err(gpu_error)?;
+            baker.bake(res, res, footprint).map_err(gpu_error)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok((bakes, gpu.describe()))
 }
 
 /// Without the `gpu` feature: an error saying how to build with it.
 #[cfg(not(feature = "gpu"))]
-pub fn bake_on_gpu(texture: &Texture, name: &str, _res: u32, _footprint: BakeFootprint) -> Result<(Bitmap, String)> {
+pub fn bake_on_gpu(
+    texture: &Texture,
+    name: &str,
+    _res: u32,
+    _footprint: BakeFootprint,
+    _samplings: &[Option<HardwareSampling>],
+) -> Result<(Vec<Bitmap>, String)> {
     tiling_blending(texture, name)?;
     Err(Error::param("gpu", "this tessera was built without the `gpu` feature: cargo build --release --features gpu"))
+}
+
+/// How the GPU reads the exemplar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SamplingArg {
+    /// The shader's own filters, in f32 with textureLoad (regime (a) of docs/gpu.md).
+    Shader,
+    /// The texture unit: textureSampleGrad through a trilinear, anisotropic sampler (regime (b)).
+    Hardware,
 }
 
 /// `tessera gpu-check`'s arguments.
@@ -100,6 +138,26 @@ pub struct GpuCheckArgs {
     /// Read 8-bit images as data (no sRGB decoding).
     #[arg(long)]
     data: bool,
+    /// How the GPU reads the exemplar. `hardware` bakes it four ways (the shader's filters, then
+    /// the texture unit isotropic with the footprint doubled and as it is, then anisotropic)
+    /// and prints each one's difference; the verdict and the details are the last one's.
+    #[arg(long, value_enum, default_value = "shader")]
+    sampling: SamplingArg,
+    /// The sampler's anisotropy clamp with `--sampling hardware` (1 to 16).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=16))]
+    anisotropy: u16,
+}
+
+/// The ways `gpu-check --sampling hardware` reads the exemplar, described: from regime (a) to an
+/// engine's textureSampleGrad, one difference at a time.
+fn hardware_samplings(anisotropy: u16) -> Vec<(Option<HardwareSampling>, String)> {
+    let hardware = |anisotropy, gradient_scale| Some(HardwareSampling { anisotropy, gradient_scale });
+    vec![
+        (None, "shader, f32 filters (regime (a))".into()),
+        (hardware(1, 2.0), "texture unit, isotropic, footprint x2 (about tessera's trilinear level)".into()),
+        (hardware(1, 1.0), "texture unit, isotropic, footprint x1 (the GPU's level of detail)".into()),
+        (hardware(anisotropy, 1.0), format!("texture unit, anisotropy {anisotropy}, footprint x1 (textureSampleGrad)")),
+    ]
 }
 
 /// Run `tessera gpu-check`: exit 0 when the GPU bake matches the CPU's within the tolerance.
@@ -109,10 +167,23 @@ pub fn check(args: &GpuCheckArgs) -> Result<ExitCode> {
     }
     let texture = tessera::scene::load_texture(&args.scene, &args.texture, !args.data)?;
     let footprint = args.footprint.into();
-    let (gpu, adapter) = bake_on_gpu(&texture, &args.texture, args.res, footprint)?;
+    let samplings = match args.sampling {
+        SamplingArg::Shader => vec![(None, String::new())],
+        SamplingArg::Hardware => hardware_samplings(args.anisotropy),
+    };
+    let sampling_of: Vec<Option<HardwareSampling>> = samplings.iter().map(|(s, _)| *s).collect();
+    let (bakes, adapter) = bake_on_gpu(&texture, &args.texture, args.res, footprint, &sampling_of)?;
     let cpu = bake(&texture, args.res as usize, footprint);
-    let diff = TexelDifference::new(&gpu, &cpu, args.worst)?;
+    let mut diffs = bakes.iter().map(|gpu| TexelDifference::new(gpu, &cpu, args.worst)).collect::<Result<Vec<_>>>()?;
+    let diff = diffs.pop().expect("one bake at least");
     print_report(&args.scene, &args.texture, &adapter, args.res, &diff);
+    if args.sampling == SamplingArg::Hardware {
+        println!("  the exemplar read by:                                                      max |gpu - cpu|   mean");
+        for ((_, name), d) in samplings.iter().zip(diffs.iter().chain([&diff])) {
+            let mean = d.mean_abs.iter().cloned().fold(0.0f64, f64::max);
+            println!("    {name:<72} {:>9.3e} {:>9.3e}", d.max(), mean);
+        }
+    }
     if let Some(path) = &args.error_image {
         write_error_image(path, &diff.error_image)?;
     }
@@ -179,6 +250,13 @@ pub struct GpuViewArgs {
     /// Also time the GPU view: frames per second, median of 5 batches.
     #[arg(long)]
     time: bool,
+    /// How the GPU reads the exemplar: the shader's f32 filters, or the texture unit
+    /// (textureSampleGrad with the footprint as it is, anisotropic: what an engine's shader does).
+    #[arg(long, value_enum, default_value = "shader")]
+    sampling: SamplingArg,
+    /// The sampler's anisotropy clamp with `--sampling hardware` (1 to 16).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u16).range(1..=16))]
+    anisotropy: u16,
     /// Read 8-bit images as data (no sRGB decoding).
     #[arg(long)]
     data: bool,
@@ -216,9 +294,11 @@ fn draw_on_gpu(
     texture: &Texture,
     args: &GpuViewArgs,
 ) -> Result<GpuViews> {
+    let texture = tiling_blending(texture, &args.texture)?;
     let gpu = tessera::gpu::Gpu::new().map_err(gpu_error)?;
-    let view =
-        tessera::gpu::GpuView::new(&gpu, scene, camera, tiling_blending(texture, &args.texture)?).map_err(gpu_error)?;
+    let hardware = (args.sampling == SamplingArg::Hardware)
+        .then_some(HardwareSampling { anisotropy: args.anisotropy, gradient_scale: 1.0 });
+    let view = tessera::gpu::GpuView::new(&gpu, scene, camera, texture, hardware).map_err(gpu_error)?;
     let views =
         Derivatives::ALL.iter().map(|&d| Ok((d, view.render(d).map_err(gpu_error)?))).collect::<Result<Vec<_>>>()?;
     let seconds_per_frame = if args.time {
@@ -262,6 +342,9 @@ pub fn view(args: &GpuViewArgs) -> Result<ExitCode> {
     let reference = primary_view(&scene, &camera, &texture);
     let seen = reference.triangle.iter().filter(|&&t| t != 0).count();
     println!("{}: texture '{}', {width}x{height} pixels, GPU {}", args.scene.display(), args.texture, gpu.adapter);
+    if args.sampling == SamplingArg::Hardware {
+        println!("  the GPU samples the exemplar with its texture unit, anisotropy {} (regime (b))", args.anisotropy);
+    }
     println!("  tessera: camera rays through pixel centres, ray differentials; {seen} pixels see a surface");
     println!(
         "  {:<7} {:>9} {:>9} {:>9}  {:>9} {:>9}  {:>9} {:>9} {:>9}",
@@ -293,6 +376,15 @@ pub fn view(args: &GpuViewArgs) -> Result<ExitCode> {
     }
     println!("  (max and mean |gpu - tessera| over channels and the pixels both see on the same triangle;");
     println!("   footprint error: max(|dx - dx'|, |dy - dy'|) / max(|dx'|, |dy'|), ' tessera's)");
+    let sensitivity = ulp_sensitivity(&scene, &camera, &texture);
+    let sensitivity = ErrorQuantiles::new(
+        sensitivity.into_iter().zip(&reference.triangle).filter(|&(_, &t)| t != 0).map(|(s, _)| s).collect(),
+    );
+    println!(
+        "  one f32 ulp of UV moves tessera's value by up to {:.2e} (p99 {:.2e}, median {:.2e}): differences of that order",
+        sensitivity.max, sensitivity.p99, sensitivity.median
+    );
+    println!("  come from the UVs' last bits alone (docs/gpu.md)");
     let ray = ray_difference.expect("the ray view is drawn");
     if !ray.value.worst.is_empty() {
         println!("  worst pixels with ray differentials (x, y from the top-left):");

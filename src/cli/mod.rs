@@ -319,7 +319,8 @@ pub fn run() -> Result<ExitCode> {
             let footprint = footprint.into();
             let start = Instant::now();
             let (image, device) = if gpu {
-                let (image, adapter) = gpu::bake_on_gpu(&tex, &texture, res, footprint)?;
+                let (mut images, adapter) = gpu::bake_on_gpu(&tex, &texture, res, footprint, &[None])?;
+                let image = images.pop().expect("one bake");
                 (image, format!(" on {adapter}"))
             } else {
                 (bake(&tex, res as usize, footprint), String::new())

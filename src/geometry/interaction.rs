@@ -115,26 +115,17 @@ impl SurfaceInteraction {
         self.duv_dy = solve(dpdy);
     }
 
-    /// Footprint from the offset rays of a ray differential: intersect each with the tangent
-    /// plane at the hit. Returns false (and leaves the footprint alone) when an offset ray is
-    /// parallel to the plane.
-    pub fn footprint_from_differential(&mut self, diff: &RayDifferential) -> bool {
-        let n = self.ng;
-        let d = n.dot(self.p);
-        let hit = |o: Vec3, dir: Vec3| {
-            let denom = n.dot(dir);
-            if denom == 0.0 {
-                return None;
-            }
-            let t = (d - n.dot(o)) / denom;
-            t.is_finite().then(|| o + dir * t)
-        };
-        match (hit(diff.rx_o, diff.rx_d), hit(diff.ry_o, diff.ry_d)) {
-            (Some(px), Some(py)) => {
-                self.set_footprint(px - self.p, py - self.p);
+    /// Footprint from the neighbouring rays of a ray differential of the ray from `o` that
+    /// made this hit: where they meet the tangent plane at the hit
+    /// ([`RayDifferential::steps_on_plane`]). Returns false (and leaves the footprint alone)
+    /// when a neighbouring ray is parallel to the plane.
+    pub fn footprint_from_differential(&mut self, o: Vec3, diff: &RayDifferential) -> bool {
+        match diff.steps_on_plane(o, self.p, self.ng) {
+            Some((dpdx, dpdy)) => {
+                self.set_footprint(dpdx, dpdy);
                 true
             }
-            _ => false,
+            None => false,
         }
     }
 

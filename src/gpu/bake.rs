@@ -5,6 +5,7 @@ use super::synthesis::{SynthesisGroup, layout_entry, shader_module, uniform_entr
 use super::{Gpu, GpuError};
 use crate::image::Bitmap;
 use crate::shader::BAKE_ENTRY_POINT;
+use crate::texture::tiling_blending::params::HardwareSampling;
 use crate::texture::{BakeFootprint, BakeParams, TilingBlending};
 use wgpu::util::DeviceExt;
 
@@ -24,9 +25,19 @@ impl<'g> GpuBake<'g> {
     /// Upload `texture` (its exemplar pyramid, F map, priority map and inverse histogram
     /// tables) and build the pipeline; an error names what the port lacks for this texture.
     pub fn new(gpu: &'g Gpu, texture: &TilingBlending) -> Result<Self, GpuError> {
+        Self::with_sampling(gpu, texture, None)
+    }
+
+    /// [`GpuBake::new`], the exemplar read by the shader's f32 filters (`hardware` None: regime
+    /// (a) of docs/gpu.md) or by the texture unit (regime (b)).
+    pub fn with_sampling(
+        gpu: &'g Gpu,
+        texture: &TilingBlending,
+        hardware: Option<HardwareSampling>,
+    ) -> Result<Self, GpuError> {
         let device = &gpu.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let synthesis = SynthesisGroup::new(gpu, texture)?;
+        let synthesis = SynthesisGroup::new(gpu, texture, hardware)?;
         let module = shader_module(gpu);
         let storage = wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: false },

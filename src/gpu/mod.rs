@@ -51,6 +51,8 @@ impl Gpu {
         let info = adapter.get_info();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("tessera"),
+            // Filtering f32 textures where the GPU can: hardware sampling of the exemplar.
+            required_features: adapter.features() & wgpu::Features::FLOAT32_FILTERABLE,
             required_limits: adapter.limits(),
             ..Default::default()
         }))

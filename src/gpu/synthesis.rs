@@ -1,11 +1,12 @@
 //! What every GPU pipeline of tiling and blending shares: the shader module, and a texture's
 //! synthesis uploaded as `shaders/tiling_blending/params.wgsl`'s group 0 (the parameter block,
-//! the exemplar's pyramid, the F map, the priority map and the inverse histogram tables).
+//! the exemplar's pyramid, the F map, the priority map, the inverse histogram tables, the
+//! hardware sampler) and `cuts.wgsl`'s cut bands.
 
 use super::{Gpu, GpuError};
 use crate::image::Bitmap;
 use crate::shader::wgsl_source;
-use crate::texture::tiling_blending::params::GpuSynthesis;
+use crate::texture::tiling_blending::params::{GpuCuts, GpuSynthesis, HardwareSampling};
 use crate::texture::{MipMap, TilingBlending};
 use wgpu::util::DeviceExt;
 
@@ -98,11 +99,73 @@ fn upload_mipmap(gpu: &Gpu, label: &str, mipmap: Option<&MipMap>) -> wgpu::Textu
     upload_pyramid(gpu, label, &levels)
 }
 
+/// A read-only storage buffer's layout entry.
+fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    layout_entry(
+        binding,
+        STAGES,
+        wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+    )
+}
+
+/// The cut bands uploaded (`cuts.wgsl`'s bindings 6 to 9); one-element placeholders without.
+struct CutResources {
+    texels: wgpu::Texture,
+    points: wgpu::Buffer,
+    curves: wgpu::Buffer,
+    anchors: wgpu::Buffer,
+}
+
+impl CutResources {
+    fn new(gpu: &Gpu, cuts: Option<&GpuCuts>) -> Self {
+        let empty = GpuCuts {
+            res: 1,
+            texels: vec![[u32::MAX, 0, u32::MAX, 0]],
+            points: vec![Default::default()],
+            curves: vec![Default::default()],
+            anchors: vec![[0.0; 2]],
+        };
+        let cuts = cuts.unwrap_or(&empty);
+        let buffer = |label, contents: &[u8]| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let texels = gpu.device.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("cut texels"),
+                size: wgpu::Extent3d { width: cuts.res as u32, height: cuts.res as u32, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(&cuts.texels),
+        );
+        CutResources {
+            texels,
+            points: buffer("cut points", bytemuck::cast_slice(&cuts.points)),
+            curves: buffer("cut curves", bytemuck::cast_slice(&cuts.curves)),
+            anchors: buffer("cut anchors", bytemuck::cast_slice(&cuts.anchors)),
+        }
+    }
+}
+
 /// A texture's synthesis on the GPU: group 0 of every tiling-and-blending pipeline, and the
 /// pipeline constants that specialise the shader to it.
 pub(super) struct SynthesisGroup {
-    /// The layout of `params.wgsl`'s group 0: the parameter block and four unfilterable f32
-    /// textures read with textureLoad.
+    /// The layout of `params.wgsl`'s group 0: the parameter block, four f32 textures (read
+    /// with textureLoad, or sampled where the GPU filters f32 textures) and a sampler.
     pub layout: wgpu::BindGroupLayout,
     /// The bind group.
     pub group: wgpu::BindGroup,
@@ -111,21 +174,38 @@ pub(super) struct SynthesisGroup {
 }
 
 impl SynthesisGroup {
-    /// Upload `texture`; an error names what the port lacks for it.
-    pub fn new(gpu: &Gpu, texture: &TilingBlending) -> Result<Self, GpuError> {
-        let lookup: GpuSynthesis = texture.gpu_synthesis().map_err(GpuError)?;
+    /// Upload `texture`, its exemplar read by the shader's filters or by the texture unit
+    /// (`hardware`); an error names what the port or the GPU lacks for it.
+    pub fn new(gpu: &Gpu, texture: &TilingBlending, hardware: Option<HardwareSampling>) -> Result<Self, GpuError> {
+        let mut lookup: GpuSynthesis = texture.gpu_synthesis().map_err(GpuError)?;
         let device = &gpu.device;
+        let filterable = device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
+        if let Some(sampling) = hardware {
+            if !filterable {
+                return Err(GpuError(format!(
+                    "{} cannot filter 32-bit float textures (wgpu's FLOAT32_FILTERABLE), which hardware sampling of \
+                     the f32 exemplar needs",
+                    gpu.info.name
+                )));
+            }
+            if !(1..=16).contains(&sampling.anisotropy) {
+                return Err(GpuError(format!("anisotropy {} is outside 1..=16", sampling.anisotropy)));
+            }
+            lookup.params.sample_exemplar_in_hardware(sampling.gradient_scale);
+        }
         let texture_entry = |binding| {
             layout_entry(
                 binding,
                 STAGES,
                 wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    sample_type: wgpu::TextureSampleType::Float { filterable },
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
                 },
             )
         };
+        let sampler_type =
+            if filterable { wgpu::SamplerBindingType::Filtering } else { wgpu::SamplerBindingType::NonFiltering };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("synthesis"),
             entries: &[
@@ -134,7 +214,33 @@ impl SynthesisGroup {
                 texture_entry(2),
                 texture_entry(3),
                 texture_entry(4),
+                layout_entry(5, STAGES, wgpu::BindingType::Sampler(sampler_type)),
+                layout_entry(
+                    6,
+                    STAGES,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Uint,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
+                storage_entry(7),
+                storage_entry(8),
+                storage_entry(9),
             ],
+        });
+        // Trilinear with repeat wrapping, as tessera's filters; nearest where the GPU does not
+        // filter f32 (the shader's filters then never sample).
+        let linear = if filterable { wgpu::FilterMode::Linear } else { wgpu::FilterMode::Nearest };
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("hardware sampler"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: linear,
+            min_filter: linear,
+            mipmap_filter: if filterable { wgpu::MipmapFilterMode::Linear } else { wgpu::MipmapFilterMode::Nearest },
+            anisotropy_clamp: hardware.map_or(1, |h| h.anisotropy),
+            ..Default::default()
         });
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("synthesis params"),
@@ -155,6 +261,13 @@ impl SynthesisGroup {
                 binding: i as u32 + 1,
                 resource: wgpu::BindingResource::TextureView(view),
             });
+        }
+        entries.push(wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::Sampler(&sampler) });
+        let cuts = CutResources::new(gpu, lookup.cuts.as_ref());
+        let cut_texels = cuts.texels.create_view(&Default::default());
+        entries.push(wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&cut_texels) });
+        for (binding, buffer) in [(7, &cuts.points), (8, &cuts.curves), (9, &cuts.anchors)] {
+            entries.push(wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() });
         }
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("synthesis"),

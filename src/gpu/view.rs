@@ -9,6 +9,7 @@ use crate::integrator::primary::{Derivatives, PrimaryView, ViewParams, ViewVerte
 use crate::scene::Scene;
 use crate::shader::VIEW_ENTRY_POINTS;
 use crate::texture::TilingBlending;
+use crate::texture::tiling_blending::params::HardwareSampling;
 use wgpu::util::DeviceExt;
 
 /// The colour targets: the value, the footprint (both RGBA f32) and the triangle plus one.
@@ -50,12 +51,14 @@ fn target(gpu: &Gpu, label: &str, format: wgpu::TextureFormat, width: u32, heigh
 
 impl<'g> GpuView<'g> {
     /// Upload `scene`'s triangles and `texture`, for views through `camera` (its resolution is
-    /// the view's); an error names what the GPU or the port lacks.
+    /// the view's), the exemplar read by the shader's f32 filters or by the texture unit
+    /// (`hardware`); an error names what the GPU or the port lacks.
     pub fn new(
         gpu: &'g Gpu,
         scene: &Scene,
         camera: &PerspectiveCamera,
         texture: &TilingBlending,
+        hardware: Option<HardwareSampling>,
     ) -> Result<Self, GpuError> {
         let device = &gpu.device;
         let (width, height) = camera.resolution();
@@ -79,7 +82,7 @@ impl<'g> GpuView<'g> {
             )));
         }
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let synthesis = SynthesisGroup::new(gpu, texture)?;
+        let synthesis = SynthesisGroup::new(gpu, texture, hardware)?;
         let module = shader_module(gpu);
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let storage = wgpu::BindingType::Buffer {

@@ -119,7 +119,7 @@ impl<'a> PathTracer<'a> {
             // differentials at the first hit, from the camera-based approximation after (pbrt-v4).
             let wants_footprint =
                 self.needs_footprint[shape.material as usize] || (depth == 0 && self.record_footprint);
-            if wants_footprint && (depth > 0 || !si.footprint_from_differential(diff)) {
+            if wants_footprint && (depth > 0 || !si.footprint_from_differential(ray.o, diff)) {
                 let (dpdx, dpdy) = scene.camera.approximate_dp_dxy(si.p, si.ng);
                 si.set_footprint(dpdx, dpdy);
             }

@@ -46,7 +46,7 @@ pub fn primary_lookup(scene: &Scene, camera: &PerspectiveCamera, film: Vec2) -> 
     let (ray, diff) = camera.generate_ray(film);
     let hit = scene.accel.intersect(&ray)?;
     let mut si = scene.interaction(&ray, &hit);
-    if !si.footprint_from_differential(&diff) {
+    if !si.footprint_from_differential(ray.o, &diff) {
         let (dpdx, dpdy) = camera.approximate_dp_dxy(si.p, si.ng);
         si.set_footprint(dpdx, dpdy);
     }
@@ -82,6 +82,31 @@ pub fn primary_view(scene: &Scene, camera: &PerspectiveCamera, texture: &Texture
             }
         });
     view
+}
+
+/// Per pixel (row-major, 0 where nothing is seen), how far `texture`'s value at the camera
+/// ray's hit moves when its UV moves by one f32 ulp along u or along v (the largest change over
+/// channels and the two directions, the footprint kept): the difference that a view whose UVs
+/// come from other arithmetic (a rasteriser's interpolation, another ray-triangle test, fused
+/// multiply-adds) must expect from the UVs' last bits alone.
+pub fn ulp_sensitivity(scene: &Scene, camera: &PerspectiveCamera, texture: &Texture) -> Vec<f32> {
+    let (width, height) = camera.resolution();
+    let (width, height) = (width as usize, height as usize);
+    let mut sensitivity = vec![0.0; width * height];
+    sensitivity.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
+        for (x, out) in row.iter_mut().enumerate() {
+            let Some((ctx, _)) = primary_lookup(scene, camera, Vec2::new(x as f32 + 0.5, y as f32 + 0.5)) else {
+                continue;
+            };
+            let value = texture.eval(&ctx);
+            let moved = |uv: Vec2| (texture.eval(&TexCtx { uv, ..ctx }) - value).abs().max_element();
+            // One ulp: the gap from |x| to the next larger f32.
+            let ulp = |x: f32| f32::from_bits(x.abs().to_bits() + 1) - x.abs();
+            let (du, dv) = (Vec2::new(ulp(ctx.uv.x), 0.0), Vec2::new(0.0, ulp(ctx.uv.y)));
+            *out = moved(ctx.uv + du).max(moved(ctx.uv + dv));
+        }
+    });
+    sensitivity
 }
 
 /// Quantiles of a set of non-negative errors.

@@ -144,7 +144,7 @@ pub const BANDS_PER_POINT: usize = 2;
 /// Segments either side of a texel's nearest one searched for a point's nearest (a point within
 /// a texel of the texel's centre has its nearest point of the cut a texel from the centre's)
 /// and for the arc length the row's weights use.
-const SEARCH: usize = 4;
+pub(crate) const SEARCH: usize = 4;
 
 /// Most texel visits of the bands' rasterisation (a few seconds).
 const MAX_BAND_WORK: u64 = 1 << 28;
@@ -352,6 +352,32 @@ impl CutBands {
         let t = (sigma - m as f32).clamp(0.0, 1.0);
         let tile = |m: i64, w: f32| (m, w, g - self.anchors[c][m as usize] + offset);
         Some(BandLookup { weight, curve: r.curve, tiles: [tile(m, 1.0 - t), tile(m + 1, t)], reach: 2.0 * h })
+    }
+
+    /// The bands as the GPU port reads them (`shaders/tiling_blending/cuts.wgsl`).
+    pub fn gpu_cuts(&self) -> super::params::GpuCuts {
+        use super::params::{CutCurveParams, CutPointParams, GpuCuts};
+        let texels = self.texels.iter().map(|[a, b]| [a.curve, a.segment_side, b.curve, b.segment_side]).collect();
+        let (mut points, mut curves, mut anchors) = (Vec::new(), Vec::new(), Vec::new());
+        for ((curve, spacing), row) in self.curves.iter().zip(&self.spacing).zip(&self.anchors) {
+            curves.push(CutCurveParams {
+                first_point: points.len() as u32,
+                point_count: curve.points.len() as u32,
+                first_anchor: anchors.len() as u32,
+                anchor_count: row.len() as u32,
+                spacing: *spacing,
+                padding: [0; 3],
+            });
+            points.extend(curve.points.iter().map(|p| CutPointParams {
+                uv0: p.uv[0].to_array(),
+                uv1: p.uv[1].to_array(),
+                g: p.g.to_array(),
+                s: p.s,
+                padding: 0,
+            }));
+            anchors.extend(row.iter().map(|g| g.to_array()));
+        }
+        GpuCuts { res: self.res, texels, points, curves, anchors }
     }
 
     /// Bytes held.

@@ -22,6 +22,11 @@ pub use deformation::{Deformation, DeformationField, MAX_DEFORMATION};
 pub use histogram::GaussianizedExemplar;
 pub use lattice::{lattice_frequencies, lattice_visibility, synthesis_lattice_visibility};
 pub use operators::{Blend, PriorityMap};
+// Constants the shaders repeat, which `src/shader.rs`'s tests compare.
+#[cfg(test)]
+pub(crate) use cuts::SEARCH as CUT_SEARCH;
+#[cfg(test)]
+pub(crate) use shift::CUT_SALT;
 pub use shift::{cut_shift, fold_seed, shift};
 pub use synthesis::{MAX_LOOKUPS, Synthesis, TileLookup};
 pub use tiling::{MAX_TILES, Tile, Tiling};

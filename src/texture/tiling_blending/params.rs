@@ -25,6 +25,9 @@ pub const FILTER_NONE: u32 = 0;
 pub const FILTER_TRILINEAR: u32 = 1;
 /// See [`FILTER_NONE`].
 pub const FILTER_EWA: u32 = 2;
+/// GPU only: `textureSampleGrad` through a linear sampler, the texture unit filtering (regime
+/// (b) of docs/gpu.md); the CPU has no such filter.
+pub const FILTER_HARDWARE: u32 = 3;
 
 /// [`Blend`] codes of `SynthesisParams::blend`.
 pub const BLEND_LINEAR: u32 = 0;
@@ -59,8 +62,11 @@ pub struct ImageParams {
     pub scale: [f32; 2],
     /// Offset added after scaling.
     pub offset: [f32; 2],
+    /// With `FILTER_HARDWARE`: the factor the footprint is scaled by before `textureSampleGrad`
+    /// (1: the GPU's level of detail; 2: about tessera's trilinear level). Unused otherwise.
+    pub gradient_scale: f32,
     /// Padding to 8-byte alignment (WGSL's vec2).
-    pub padding: [u32; 2],
+    pub padding: u32,
 }
 
 /// One factor of the deformation field (WGSL `FactorParams`). `values` by kind: constant
@@ -104,9 +110,79 @@ pub struct SynthesisParams {
     pub priority: ImageParams,
     /// The deformation field's factors, F = F_1 ... F_n.
     pub factors: [FactorParams; MAX_GPU_FACTORS],
+    /// 1 when the synthesis has cut bands ([`GpuCuts`]).
+    pub cuts: u32,
+    /// Padding to 16-byte alignment.
+    pub padding: [u32; 3],
+}
+
+/// A point of a cut as `shaders/tiling_blending/cuts.wgsl` reads it ([`super::CutPoint`]).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CutPointParams {
+    /// UV on side 0.
+    pub uv0: [f32; 2],
+    /// UV on side 1.
+    pub uv1: [f32; 2],
+    /// The developed exemplar coordinate g(s).
+    pub g: [f32; 2],
+    /// Arc length.
+    pub s: f32,
+    /// Padding to 8-byte alignment.
+    pub padding: u32,
+}
+
+/// A cut as `cuts.wgsl` reads it: where its points and its row's anchors g(s_m) start in
+/// [`GpuCuts`]' arrays, how many, and its row's tile spacing.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CutCurveParams {
+    /// Index of its first point.
+    pub first_point: u32,
+    /// Its number of points.
+    pub point_count: u32,
+    /// Index of its first anchor.
+    pub first_anchor: u32,
+    /// Its number of anchors.
+    pub anchor_count: u32,
+    /// Tile spacing along it, in map units.
+    pub spacing: f32,
+    /// Padding to 16-byte alignment.
+    pub padding: [u32; 3],
+}
+
+/// The cut bands ([`super::CutBands`]) as the shader reads them.
+pub struct GpuCuts {
+    /// Side of the square raster of nearest cut sides.
+    pub res: usize,
+    /// Per texel, row 0 at v = 1: the two nearest cut sides as (curve, segment index times 2
+    /// plus the side), curve `u32::MAX` for none.
+    pub texels: Vec<[u32; 4]>,
+    /// Every cut's points, one cut after the other.
+    pub points: Vec<CutPointParams>,
+    /// The cuts.
+    pub curves: Vec<CutCurveParams>,
+    /// Every cut's anchors g(s_m), one cut after the other.
+    pub anchors: Vec<[f32; 2]>,
+}
+
+/// Regime (b) of docs/gpu.md: the exemplar read by the GPU's texture unit (`textureSampleGrad`
+/// through a trilinear sampler) instead of the shader's f32 filters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HardwareSampling {
+    /// The sampler's anisotropy clamp: 1 (isotropic trilinear) to 16.
+    pub anisotropy: u16,
+    /// The footprint's scale (see [`ImageParams::gradient_scale`]).
+    pub gradient_scale: f32,
 }
 
 impl SynthesisParams {
+    /// Read the exemplar in hardware (`FILTER_HARDWARE`), its footprint scaled by `gradient_scale`.
+    pub fn sample_exemplar_in_hardware(&mut self, gradient_scale: f32) {
+        self.exemplar.filtering = FILTER_HARDWARE;
+        self.exemplar.gradient_scale = gradient_scale;
+    }
+
     /// The pipeline constants that specialise the shader to this configuration (the overrides
     /// of `params.wgsl`): the compiler then drops the code of other pavings, operators,
     /// filters and factors. The uniform block still carries the same codes.
@@ -117,6 +193,7 @@ impl SynthesisParams {
             ("EXEMPLAR_FILTERING", self.exemplar.filtering as f64),
             ("PRIORITY_FILTERING", self.priority.filtering as f64),
             ("FACTOR_COUNT", self.factor_count as f64),
+            ("CUTS", self.cuts as f64),
         ];
         const KINDS: [&str; MAX_GPU_FACTORS] = ["FACTOR0_KIND", "FACTOR1_KIND", "FACTOR2_KIND", "FACTOR3_KIND"];
         for (name, factor) in KINDS.iter().zip(&self.factors).take(self.factor_count as usize) {
@@ -139,6 +216,8 @@ pub struct GpuSynthesis<'a> {
     pub priority: Option<&'a MipMap>,
     /// The inverse histogram tables ([`super::GaussianizedExemplar::inverse_tables`]).
     pub inverse_tables: Option<Bitmap>,
+    /// The cut bands.
+    pub cuts: Option<GpuCuts>,
 }
 
 impl ImageParams {
@@ -153,7 +232,8 @@ impl ImageParams {
             levels: image.mipmap.level_count() as u32,
             scale: image.scale.to_array(),
             offset: image.offset.to_array(),
-            padding: [0; 2],
+            gradient_scale: 1.0,
+            padding: 0,
         })
     }
 }
@@ -175,9 +255,6 @@ impl TilingBlending {
     /// This texture as the WGSL port reads it, or what the port lacks to read it.
     pub fn gpu_synthesis(&self) -> Result<GpuSynthesis<'_>, String> {
         let s = &*self.synthesis;
-        if s.cuts.is_some() {
-            return Err("cut bands are not ported to the GPU yet".into());
-        }
         let factors = s.deformation.as_ref().map_or(&[][..], |d| d.factors());
         if factors.len() > MAX_GPU_FACTORS {
             return Err(format!(
@@ -228,6 +305,15 @@ impl TilingBlending {
             Exemplar::Gaussianized(g) => (&g.gaussian, Some(g.inverse_tables())),
         };
         params.exemplar = ImageParams::new(exemplar)?;
-        Ok(GpuSynthesis { params, exemplar: &exemplar.mipmap, f_map: maps.first().copied(), priority, inverse_tables })
+        let cuts = s.cuts.as_ref().map(|c| c.gpu_cuts());
+        params.cuts = cuts.is_some() as u32;
+        Ok(GpuSynthesis {
+            params,
+            exemplar: &exemplar.mipmap,
+            f_map: maps.first().copied(),
+            priority,
+            inverse_tables,
+            cuts,
+        })
     }
 }

@@ -30,7 +30,7 @@ pub fn fold_seed(seed: u64) -> u32 {
 
 /// Salt of the cut bands' key space, so that a band's tiles never share a lattice vertex's
 /// shift.
-const CUT_SALT: u32 = 0x9e37_79b9;
+pub(crate) const CUT_SALT: u32 = 0x9e37_79b9;
 
 /// The pseudo-random shift h of a lattice vertex under `seed`: uniform over the exemplar's unit
 /// square (the exemplar repeats with period 1), 24 bits per axis.
