@@ -402,7 +402,7 @@ fn gpu_commands_name_what_is_wrong() {
     assert!(stderr_of(&["gpu-check", scene, "--texture", "tb", "--tolerance", "NaN"]).contains("--tolerance"));
     assert!(stderr_of(&["gpu-check", scene, "--texture", "nope"]).contains("unknown texture 'nope'"));
     assert!(stderr_of(&["gpu-view", scene, "--texture", "e"]).contains("not a tiling_blending texture"));
-    assert!(stderr_of(&["gpu-view", scene, "--texture", "tb", "--tolerance", "-1"]).contains("--tolerance"));
+    assert!(stderr_of(&["gpu-view", scene, "--texture", "tb", "--tolerance=-1"]).contains("--tolerance"));
     let msg = stderr_of(&["gpu-view", scene, "--texture", "tb", "-o", "view.txt"]);
     assert!(msg.contains("view.txt"), "{msg}");
     // Sizes clap refuses (exit status 2), saying why.
