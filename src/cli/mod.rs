@@ -520,65 +520,36 @@ fn diff(
         }
     };
     let r = finite(reference)?;
-    let m = compare::image_metrics(&t, &r)?;
+    let v = variance.map(|(path, spp)| Ok((finite(path)?, spp))).transpose()?;
+    let criteria = compare::Criteria { z_test: v.as_ref().map(|(v, spp)| (v, *spp)), max_relmse, max_flip };
+    let verdict = compare::judge(&t, invalid, &r, &criteria)?;
+    let m = &verdict.metrics;
     println!("relmse     {:.6e}", m.relmse);
     println!("mae        {:.6e}", m.mae);
     println!("flip       {:.6}  (mean LDR-FLIP)", m.mean_flip);
     println!("mean       test {:?}, reference {:?}", m.mean_test.map(|v| v as f32), m.mean_reference.map(|v| v as f32));
-    let mut failures = Vec::new();
-    if invalid > 0 {
-        failures.push(format!("{invalid} values of the test image are NaN or infinite"));
+    if let Some(z) = &verdict.z {
+        println!(
+            "z-test     {:.4}% of pixels accepted (need {}%), alpha {:.3e}, min p {:.3e}",
+            100.0 * z.accepted_fraction,
+            100.0 * compare::PASS_FRACTION,
+            z.alpha,
+            z.min_p
+        );
+        println!("mean z     {:?}", z.mean_z.map(|v| (v * 100.0).round() / 100.0));
     }
-    if let Some(limit) = max_relmse.filter(|l| m.relmse > *l) {
-        failures.push(format!("relMSE {:.4e} > {limit:e}", m.relmse));
-    }
-    if let Some(limit) = max_flip.filter(|l| m.mean_flip > *l) {
-        failures.push(format!("mean FLIP {:.4} > {limit}", m.mean_flip));
-    }
-    let z = match variance {
-        Some((path, spp)) => {
-            let v = finite(path)?;
-            let z = compare::z_test(&t, spp, &r, &v)?;
-            println!(
-                "z-test     {:.4}% of pixels accepted (need {}%), alpha {:.3e}, min p {:.3e}",
-                100.0 * z.accepted_fraction,
-                100.0 * compare::PASS_FRACTION,
-                z.alpha,
-                z.min_p
-            );
-            println!("mean z     {:?}", z.mean_z.map(|v| (v * 100.0).round() / 100.0));
-            if !z.pixels_pass() {
-                failures.push(format!("only {:.3}% of pixels pass the Z-test", 100.0 * z.accepted_fraction));
-            }
-            if !z.mean_passes(5.0) {
-                failures.push(format!("the image mean is off by {:?} standard errors", z.mean_z.map(|v| v as f32)));
-            }
-            Some(z)
-        }
-        None => None,
-    };
     if let Some(out) = output {
-        let flip = compare::flip_map(&t, &r)?;
-        let mut err = tessera::image::Bitmap::new(t.width, t.height, 3);
-        for (i, e) in err.data.iter_mut().enumerate() {
-            let (px, c) = (i / 3, i % 3);
-            *e = (t.pixel(px % t.width, px / t.width)[c] - r.pixel(px % r.width, px / r.width)[c]).abs();
+        let mut extra: Vec<(&[&str], tessera::image::Bitmap)> = vec![(&["flip.Y"], compare::flip_map(&t, &r)?)];
+        if let Some(z) = &verdict.z {
+            extra.push((&["pvalue.Y"], z.min_p_image()));
         }
-        let mut extra: Vec<(&[&str], tessera::image::Bitmap)> = vec![(&["flip.Y"], flip)];
-        if let Some(z) = &z {
-            let mut min_p = tessera::image::Bitmap::new(t.width, t.height, 1);
-            for (i, v) in min_p.data.iter_mut().enumerate() {
-                *v = z.p_values.data[3 * i..3 * i + 3].iter().copied().fold(1.0, f32::min);
-            }
-            extra.push((&["pvalue.Y"], min_p));
-        }
-        write_image(out, &err, &extra)?;
+        write_image(out, &compare::absolute_difference(&t, &r)?, &extra)?;
     }
-    if failures.is_empty() {
+    if verdict.passes() {
         println!("PASS");
         Ok(ExitCode::SUCCESS)
     } else {
-        println!("FAIL: {}", failures.join("; "));
+        println!("FAIL: {}", verdict.failures.join("; "));
         Ok(ExitCode::FAILURE)
     }
 }

@@ -62,6 +62,106 @@ impl ZTest {
     pub fn mean_passes(&self, sigmas: f64) -> bool {
         self.mean_z.iter().all(|z| z.abs() <= sigmas)
     }
+
+    /// Per pixel, the smallest p-value of its three channels (one channel).
+    pub fn min_p_image(&self) -> Bitmap {
+        let p = &self.p_values;
+        let mut out = Bitmap::new(p.width, p.height, 1);
+        for (i, v) in out.data.iter_mut().enumerate() {
+            *v = p.data[3 * i..3 * i + 3].iter().copied().fold(1.0, f32::min);
+        }
+        out
+    }
+}
+
+/// Largest |z| of a channel's image mean that passes: a bias too small for any one pixel shows
+/// there.
+pub const MEAN_SIGMAS: f64 = 5.0;
+
+/// What a test image must satisfy against its reference (`tessera diff`, the golden test).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Criteria<'a> {
+    /// Mitsuba's per-pixel Z-test and the image-mean test: the reference's per-sample variance,
+    /// and the test image's samples per pixel.
+    pub z_test: Option<(&'a Bitmap, u32)>,
+    /// Largest relMSE.
+    pub max_relmse: Option<f64>,
+    /// Largest mean FLIP.
+    pub max_flip: Option<f64>,
+}
+
+/// A test image judged against its reference: the metrics, the Z-test where asked for, and
+/// why it fails (empty when it passes).
+#[derive(Clone, Debug)]
+pub struct Verdict {
+    /// relMSE, MAE, mean FLIP, channel means.
+    pub metrics: ImageMetrics,
+    /// The Z-test, with its per-pixel p-values.
+    pub z: Option<ZTest>,
+    /// One line per failed criterion.
+    pub failures: Vec<String>,
+}
+
+impl Verdict {
+    /// True when every criterion holds.
+    pub fn passes(&self) -> bool {
+        self.failures.is_empty()
+    }
+}
+
+/// Judge `test` against `reference` by `criteria`; `invalid` counts the test image's NaN or
+/// infinite values (or samples), each a failure, counted before they were zeroed. Errors when
+/// no criterion is given or the images (or the variance) differ in size.
+pub fn judge(test: &Bitmap, invalid: usize, reference: &Bitmap, criteria: &Criteria) -> Result<Verdict> {
+    if criteria.z_test.is_none() && criteria.max_relmse.is_none() && criteria.max_flip.is_none() {
+        return Err(Error::param(
+            "criteria",
+            "give one at least: a Z-test (variance and spp), a relMSE or a FLIP limit",
+        ));
+    }
+    let metrics = image_metrics(test, reference)?;
+    let mut failures = Vec::new();
+    if invalid > 0 {
+        failures.push(format!("{invalid} values of the test image are NaN or infinite"));
+    }
+    if let Some(limit) = criteria.max_relmse.filter(|l| !(metrics.relmse <= *l)) {
+        failures.push(format!("relMSE {:.4e} > {limit:e}", metrics.relmse));
+    }
+    if let Some(limit) = criteria.max_flip.filter(|l| !(metrics.mean_flip <= *l)) {
+        failures.push(format!("mean FLIP {:.4} > {limit}", metrics.mean_flip));
+    }
+    let z = match criteria.z_test {
+        Some((variance, spp)) => {
+            let z = z_test(test, spp, reference, variance)?;
+            if !z.pixels_pass() {
+                failures.push(format!(
+                    "only {:.3}% of pixels pass the Z-test (need {}%)",
+                    100.0 * z.accepted_fraction,
+                    100.0 * PASS_FRACTION
+                ));
+            }
+            if !z.mean_passes(MEAN_SIGMAS) {
+                failures.push(format!(
+                    "the image mean is off by {:?} standard errors (at most {MEAN_SIGMAS})",
+                    z.mean_z.map(|v| v as f32)
+                ));
+            }
+            Some(z)
+        }
+        None => None,
+    };
+    Ok(Verdict { metrics, z, failures })
+}
+
+/// |test - reference| per value, RGB.
+pub fn absolute_difference(test: &Bitmap, reference: &Bitmap) -> Result<Bitmap> {
+    check_sizes(test, reference, "difference")?;
+    let mut out = Bitmap::new(test.width, test.height, 3);
+    for (i, e) in out.data.iter_mut().enumerate() {
+        let (px, c) = (i / 3, i % 3);
+        *e = (test.data[px * test.channels + c] - reference.data[px * reference.channels + c]).abs();
+    }
+    Ok(out)
 }
 
 fn check_sizes(a: &Bitmap, b: &Bitmap, what: &str) -> Result<()> {
@@ -181,6 +281,21 @@ mod tests {
         let black = image(32, 32, |_| 0.0);
         let white = image(32, 32, |_| 1.0);
         assert!(image_metrics(&black, &white).unwrap().mean_flip > 0.5);
+    }
+
+    #[test]
+    fn a_verdict_lists_every_failed_criterion() {
+        let r = image(32, 32, |_| 0.5);
+        let t = image(32, 32, |_| 0.6);
+        let loose = Criteria { max_relmse: Some(0.1), max_flip: Some(0.5), ..Default::default() };
+        assert!(judge(&t, 0, &r, &loose).unwrap().passes());
+        let tight = Criteria { max_relmse: Some(1e-3), max_flip: Some(1e-4), ..Default::default() };
+        let v = judge(&t, 2, &r, &tight).unwrap();
+        assert_eq!(v.failures.len(), 3, "{:?}", v.failures);
+        assert!(v.failures[0].contains("NaN") && v.failures[1].contains("relMSE") && v.failures[2].contains("FLIP"));
+        assert!(judge(&t, 0, &r, &Criteria::default()).is_err(), "no criterion is an error");
+        let d = absolute_difference(&t, &r).unwrap();
+        assert!(d.data.iter().all(|&e| (e - 0.1).abs() < 1e-6));
     }
 
     #[test]
