@@ -49,6 +49,7 @@ pub mod limits;
 pub mod material;
 pub mod math;
 pub mod pups;
+pub mod regress;
 pub mod sampling;
 pub mod scene;
 pub mod shader;

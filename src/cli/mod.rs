@@ -5,6 +5,7 @@ mod bench;
 mod deform;
 mod gpu;
 mod pups;
+mod regress;
 mod tiles;
 
 use clap::{Parser, Subcommand};
@@ -99,6 +100,10 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Run a regression suite (a TOML file of cases: a scene to render or a test image, a
+    /// reference, criteria), or one shard of it; print each case's metrics and verdict, the
+    /// worst first. Exits 0 when every case passes, 1 otherwise.
+    Regress(regress::RegressArgs),
     /// Lay images out on a labelled grid (PNG or EXR), e.g. classical against deformed renders.
     Montage {
         /// The images, in reading order (EXR, PNG, JPEG, HDR).
@@ -286,6 +291,7 @@ pub fn run() -> Result<ExitCode> {
             eprintln!("{} crops -> {} ({} x {})", crops.len(), output.display(), full.width, full.height);
             Ok(ExitCode::SUCCESS)
         }
+        Command::Regress(args) => regress::run(&args),
         Command::Montage { images, columns, labels, output } => {
             montage(&images, columns as usize, &labels, &output)?;
             Ok(ExitCode::SUCCESS)
@@ -497,30 +503,16 @@ fn diff(
     max_flip: Option<f64>,
     output: Option<&Path>,
 ) -> Result<ExitCode> {
-    use tessera::image::{ColorSpace, compare, read_bitmap_raw};
+    use tessera::image::compare;
     if variance.is_none() && max_relmse.is_none() && max_flip.is_none() {
         return Err(Error::param(
             "diff",
             "give a criterion: --variance with --spp (Z-test), --max-relmse or --max-flip",
         ));
     }
-    // NaN or infinity in the test image is a failure, never a value to compare (read as 0 it
-    // would pass against black); in the reference or its variance it is an error.
-    let mut t = read_bitmap_raw(test, ColorSpace::Linear)?;
-    let invalid = t.non_finite_count();
-    t.zero_negative_and_non_finite();
-    let finite = |path: &Path| -> Result<tessera::image::Bitmap> {
-        let mut image = read_bitmap_raw(path, ColorSpace::Linear)?;
-        match image.non_finite_count() {
-            0 => {
-                image.zero_negative_and_non_finite();
-                Ok(image)
-            }
-            n => Err(Error::image(path, format!("{n} values are NaN or infinite: not usable as a reference"))),
-        }
-    };
-    let r = finite(reference)?;
-    let v = variance.map(|(path, spp)| Ok((finite(path)?, spp))).transpose()?;
+    let (t, invalid) = compare::read_test_image(test)?;
+    let r = compare::read_reference(reference)?;
+    let v = variance.map(|(path, spp)| Ok((compare::read_reference(path)?, spp))).transpose()?;
     let criteria = compare::Criteria { z_test: v.as_ref().map(|(v, spp)| (v, *spp)), max_relmse, max_flip };
     let verdict = compare::judge(&t, invalid, &r, &criteria)?;
     let m = &verdict.metrics;

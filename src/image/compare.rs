@@ -153,6 +153,29 @@ pub fn judge(test: &Bitmap, invalid: usize, reference: &Bitmap, criteria: &Crite
     Ok(Verdict { metrics, z, failures })
 }
 
+/// A test image read as linear values, and how many of its values were NaN or infinite: those
+/// are a failure ([`judge`]), never values to compare (read as 0 they would pass against
+/// black), and are zeroed, as negative values are.
+pub fn read_test_image(path: &std::path::Path) -> Result<(Bitmap, usize)> {
+    let mut image = super::read_bitmap_raw(path, super::ColorSpace::Linear)?;
+    let invalid = image.non_finite_count();
+    image.zero_negative_and_non_finite();
+    Ok((image, invalid))
+}
+
+/// A reference image (or its variance) read as linear values; NaN or infinity in it is an error
+/// naming the file, negative values are zeroed.
+pub fn read_reference(path: &std::path::Path) -> Result<Bitmap> {
+    let mut image = super::read_bitmap_raw(path, super::ColorSpace::Linear)?;
+    match image.non_finite_count() {
+        0 => {
+            image.zero_negative_and_non_finite();
+            Ok(image)
+        }
+        n => Err(Error::image(path, format!("{n} values are NaN or infinite: not usable as a reference"))),
+    }
+}
+
 /// |test - reference| per value, RGB.
 pub fn absolute_difference(test: &Bitmap, reference: &Bitmap) -> Result<Bitmap> {
     check_sizes(test, reference, "difference")?;
