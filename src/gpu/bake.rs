@@ -1,7 +1,7 @@
 //! The compute bake of a tiling-and-blending texture (`shaders/bake.wgsl`): the GPU twin of
 //! [`crate::texture::bake_rect`], texel for texel.
 
-use super::synthesis::{SynthesisGroup, layout_entry, shader_module, uniform_entry, wait};
+use super::synthesis::{SynthesisGroup, layout_entry, shader_module, time_batches, uniform_entry, wait};
 use super::{Gpu, GpuError};
 use crate::image::Bitmap;
 use crate::shader::BAKE_ENTRY_POINT;
@@ -195,20 +195,11 @@ impl<'g> GpuBake<'g> {
         batches: usize,
     ) -> Result<Vec<f64>, GpuError> {
         let (_output, bands) = self.bands(width, height, footprint, self.band_rows(width, height));
-        let mut seconds = Vec::new();
-        for batch in 0..=batches {
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        time_batches(self.gpu, launches, batches, |encoder| {
             for (_, rows, group) in &bands {
-                self.dispatch(&mut encoder, group, width, *rows, launches);
+                self.dispatch(encoder, group, width, *rows, launches);
             }
-            let start = std::time::Instant::now();
-            self.gpu.queue.submit([encoder.finish()]);
-            wait(self.gpu)?;
-            if batch > 0 {
-                seconds.push(start.elapsed().as_secs_f64() / launches as f64);
-            }
-        }
-        Ok(seconds)
+        })
     }
 }
 

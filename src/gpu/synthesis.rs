@@ -278,6 +278,28 @@ impl SynthesisGroup {
     }
 }
 
+/// Seconds per unit of work: `batches` batches, each recorded by `record` (which records
+/// `units` units of work) into one submission and waited for, after one unmeasured batch.
+pub(super) fn time_batches(
+    gpu: &Gpu,
+    units: usize,
+    batches: usize,
+    record: impl Fn(&mut wgpu::CommandEncoder),
+) -> Result<Vec<f64>, GpuError> {
+    let mut seconds = Vec::new();
+    for batch in 0..=batches {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        record(&mut encoder);
+        let start = std::time::Instant::now();
+        gpu.queue.submit([encoder.finish()]);
+        wait(gpu)?;
+        if batch > 0 {
+            seconds.push(start.elapsed().as_secs_f64() / units as f64);
+        }
+    }
+    Ok(seconds)
+}
+
 /// Wait for the GPU to finish what was submitted.
 pub(super) fn wait(gpu: &Gpu) -> Result<(), GpuError> {
     gpu.device

@@ -2,7 +2,7 @@
 //! tiling-and-blending texture on every surface, the GPU twin of
 //! [`crate::integrator::primary::primary_view`], pixel for pixel.
 
-use super::synthesis::{SynthesisGroup, layout_entry, shader_module, uniform_entry, wait};
+use super::synthesis::{SynthesisGroup, layout_entry, shader_module, time_batches, uniform_entry, wait};
 use super::{Gpu, GpuError};
 use crate::camera::PerspectiveCamera;
 use crate::integrator::primary::{Derivatives, PrimaryView, ViewParams, ViewVertex, near_plane, view_geometry};
@@ -295,19 +295,10 @@ impl<'g> GpuView<'g> {
     /// frames, each batch submitted at once and waited for (after one unmeasured batch).
     pub fn time(&self, derivatives: Derivatives, frames: usize, batches: usize) -> Result<Vec<f64>, GpuError> {
         let pipeline = self.pipeline(derivatives)?;
-        let mut seconds = Vec::new();
-        for batch in 0..=batches {
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        time_batches(self.gpu, frames, batches, |encoder| {
             for _ in 0..frames {
-                self.draw(&mut encoder, &pipeline);
+                self.draw(encoder, &pipeline);
             }
-            let start = std::time::Instant::now();
-            self.gpu.queue.submit([encoder.finish()]);
-            wait(self.gpu)?;
-            if batch > 0 {
-                seconds.push(start.elapsed().as_secs_f64() / frames as f64);
-            }
-        }
-        Ok(seconds)
+        })
     }
 }
