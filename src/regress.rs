@@ -19,7 +19,10 @@
 //! Paths are relative to the suite file's folder. A ready-made test image with a variance needs
 //! its `spp`.
 
+pub mod report;
+
 use crate::error::{Error, Result};
+use crate::image::Bitmap;
 use crate::image::compare::{Criteria, Verdict, judge, read_reference, read_test_image};
 use crate::scene::{SceneOverrides, load_scene};
 use serde::Deserialize;
@@ -116,11 +119,7 @@ impl Suite {
             .enumerate()
             .map(|(i, c)| {
                 let fail = |msg: String| Error::scene(path, format!("case {} ('{}'): {msg}", i + 1, c.name));
-                let name_ok = !c.name.is_empty()
-                    && c.name.len() <= 100
-                    && c.name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch))
-                    && !c.name.starts_with('.');
-                if !name_ok {
+                if !is_case_name(&c.name) {
                     return Err(fail(
                         "a name is 1 to 100 letters, digits, '-', '_' or '.', not starting with '.'".into(),
                     ));
@@ -167,6 +166,15 @@ impl Suite {
     }
 }
 
+/// Whether `name` may name a case: 1 to 100 letters, digits, '-', '_' or '.', not starting with
+/// '.' (it names the case's folder in the report).
+fn is_case_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 100
+        && name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch))
+        && !name.starts_with('.')
+}
+
 /// Shard `index` of `count` (`--shard i/N`, 0 <= i < N, as a Slurm job array's or a Kubernetes
 /// Indexed Job's index counts): case k of a suite belongs to shard k mod N, so that the shards
 /// together run every case exactly once, and each the same cases whatever machine runs it.
@@ -204,9 +212,19 @@ impl FromStr for Shard {
     }
 }
 
-/// How a case ended: its verdict, or why it could not be judged (a scene that does not load, a
-/// missing reference: a failure of that case alone).
-pub type CaseResult = std::result::Result<Verdict, Error>;
+/// A case judged: its test image and reference (for the report) and the verdict.
+pub struct Judged {
+    /// The image under test (linear RGB).
+    pub test: Bitmap,
+    /// The reference (linear RGB).
+    pub reference: Bitmap,
+    /// The verdict, with its metrics and Z-test.
+    pub verdict: Verdict,
+}
+
+/// How a case ended: judged, or why it could not be (a scene that does not load, a missing
+/// reference: a failure of that case alone).
+pub type CaseResult = std::result::Result<Judged, Error>;
 
 /// Render or read a case's test image and judge it against its reference.
 pub fn run_case(case: &Case) -> CaseResult {
@@ -225,7 +243,8 @@ pub fn run_case(case: &Case) -> CaseResult {
     let variance = case.variance.as_deref().map(read_reference).transpose()?;
     let criteria =
         Criteria { z_test: variance.as_ref().map(|v| (v, spp)), max_relmse: case.max_relmse, max_flip: case.max_flip };
-    judge(&test, invalid, &reference, &criteria)
+    let verdict = judge(&test, invalid, &reference, &criteria)?;
+    Ok(Judged { test, reference, verdict })
 }
 
 #[cfg(test)]

@@ -70,7 +70,10 @@ fn a_failed_or_broken_case_does_not_stop_the_others() {
         variance = "var.exr"
     "#;
     std::fs::write(dir.path().join("suite.toml"), suite).unwrap();
-    let out = tessera().arg("regress").arg(dir.path().join("suite.toml")).arg("-q").output().unwrap();
+    let report = dir.path().join("report");
+    let out =
+        tessera().arg("regress").arg(dir.path().join("suite.toml")).arg("-q").arg("--report").arg(&report).output();
+    let out = out.unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
     // Every case is reported, the worst first: the one that could not run, then the failure.
@@ -82,8 +85,13 @@ fn a_failed_or_broken_case_does_not_stop_the_others() {
     assert!(stdout.contains("no_such.exr") && stdout.contains("relMSE"), "{stdout}");
     assert!(stdout.contains("FAIL: 2 of 3 cases failed"), "{stdout}");
     // Shard 2 of 3 holds the good case alone, and passes.
-    let out =
-        tessera().arg("regress").arg(dir.path().join("suite.toml")).args(["-q", "--shard", "2/3"]).output().unwrap();
+    let out = tessera()
+        .arg("regress")
+        .arg(dir.path().join("suite.toml"))
+        .args(["-q", "--shard", "2/3", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
 }
 
