@@ -30,6 +30,9 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
+/// The suite file of a suite given as a folder.
+pub const SUITE_FILE: &str = "suite.toml";
+
 /// Largest suite file read, in bytes.
 const MAX_SUITE_FILE_BYTES: u64 = 16 << 20;
 
@@ -103,9 +106,17 @@ pub struct Suite {
 }
 
 impl Suite {
-    /// Read and check a suite file: every case named (uniquely), with a scene or a test image
-    /// (not both), a reference and a criterion; errors name the file and the case.
+    /// Read and check a suite file (or a folder's `suite.toml`): every case named (uniquely),
+    /// with a scene or a test image (not both), a reference and a criterion; errors name the
+    /// file and the case.
     pub fn load(path: &Path) -> Result<Suite> {
+        let file;
+        let path = if path.is_dir() {
+            file = path.join(SUITE_FILE);
+            &file
+        } else {
+            path
+        };
         let text = crate::files::read_text_bounded(path, MAX_SUITE_FILE_BYTES, "a suite file")?;
         let desc: SuiteDesc = toml::from_str(&text).map_err(|e| Error::scene(path, e.message().to_string()))?;
         if desc.cases.is_empty() {
@@ -226,12 +237,13 @@ pub struct Judged {
 /// reference: a failure of that case alone).
 pub type CaseResult = std::result::Result<Judged, Error>;
 
-/// Render or read a case's test image and judge it against its reference.
-pub fn run_case(case: &Case) -> CaseResult {
+/// Render or read a case's test image and judge it against its reference; `progress` is told
+/// the samples done of the total, as the render goes.
+pub fn run_case(case: &Case, progress: &(dyn Fn(u64, u64) + Sync)) -> CaseResult {
     let (test, invalid, spp) = match &case.test {
         TestImage::Render { scene, spp, seed } => {
             let scene = load_scene(scene, &SceneOverrides { spp: *spp, seed: *seed, ..Default::default() })?;
-            let film = crate::integrator::render(&scene, None, &[], &|_, _| {});
+            let film = crate::integrator::render(&scene, None, &[], progress);
             (film.radiance(), film.invalid_sample_count() as usize, scene.settings.spp)
         }
         TestImage::File { path, spp } => {

@@ -70,6 +70,8 @@ fn a_failed_or_broken_case_does_not_stop_the_others() {
         variance = "var.exr"
     "#;
     std::fs::write(dir.path().join("suite.toml"), suite).unwrap();
+    // A folder stands for its suite.toml.
+    assert_eq!(Suite::load(dir.path()).unwrap().cases, Suite::load(&dir.path().join("suite.toml")).unwrap().cases);
     let report = dir.path().join("report");
     let out =
         tessera().arg("regress").arg(dir.path().join("suite.toml")).arg("-q").arg("--report").arg(&report).output();

@@ -260,3 +260,22 @@ fn the_report_works_in_a_real_browser() {
     // Four judged cases, three views of the renders each, 2x zoom: far more than 4 x 3000.
     assert!(shown > 4 * 3000, "{shown} pixels show the colour");
 }
+
+#[test]
+fn bad_report_folders_are_errors_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let suite = suite(dir.path());
+    let file = dir.path().join("a_file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let out = regress(&suite, &["--report", file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("a_file: exists and is not a folder"));
+    // A folder with no results.json, and a results.json that is not tessera's.
+    let out = regress(&suite, &["--gather", dir.path().to_str().unwrap(), "--report", "unused"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("results.json"), "{out:?}");
+    std::fs::write(dir.path().join("results.json"), r#"{"suite": "x", "cases": [{"name": "../x"}]}"#).unwrap();
+    let out = regress(&suite, &["--gather", dir.path().to_str().unwrap(), "--report", "unused"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a tessera results file"), "{out:?}");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!Path::new("unused").exists());
+}

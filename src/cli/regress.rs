@@ -11,10 +11,13 @@ use tessera::error::Result;
 use tessera::regress::report::{CaseRecord, INDEX_FILE, Outcome, Report, default_folder};
 use tessera::regress::{Case, Shard, Suite, run_case};
 
+/// Progress steps per case.
+const PER_CASE: u64 = 1000;
+
 /// `tessera regress`'s arguments.
 #[derive(clap::Args)]
 pub struct RegressArgs {
-    /// The suite file (TOML; `[[case]]` tables, see src/regress.rs).
+    /// The suite file (TOML; `[[case]]` tables, see src/regress.rs), or a folder with a suite.toml.
     suite: PathBuf,
     /// Run shard i of N only (0 <= i < N): case k belongs to shard k mod N.
     #[arg(long, value_name = "i/N", default_value = "0/1", conflicts_with = "gather")]
@@ -38,17 +41,19 @@ pub fn run(args: &RegressArgs) -> Result<ExitCode> {
     let mut report = Report::new(&folder)?;
     let cases: Vec<&Case> = if args.gather.is_empty() { suite.shard(args.shard) } else { suite.cases.iter().collect() };
     if args.gather.is_empty() {
-        let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(cases.len() as u64) };
+        // The bar counts thousandths of cases, so that a long render moves it (and its ETA).
+        let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(PER_CASE * cases.len() as u64) };
         bar.set_style(
-            ProgressStyle::with_template("{bar:30} {pos}/{len} cases [{elapsed_precise}, ETA {eta}] {msg}")
+            ProgressStyle::with_template("{bar:30} {percent}% of {msg} [{elapsed_precise}, ETA {eta}]")
                 .expect("valid template"),
         );
-        for case in &cases {
-            bar.set_message(case.name.clone());
+        for (k, case) in cases.iter().enumerate() {
+            bar.set_message(format!("{} cases: {} ({} of {})", cases.len(), case.name, k + 1, cases.len()));
             let start = Instant::now();
-            let result = run_case(case);
+            let base = PER_CASE * k as u64;
+            let result = run_case(case, &|done, total| bar.set_position(base + PER_CASE * done / total.max(1)));
             report.add(case, &result, start.elapsed().as_secs_f64())?;
-            bar.inc(1);
+            bar.set_position(base + PER_CASE);
         }
         bar.finish_and_clear();
     } else {
