@@ -324,6 +324,24 @@ fn bad_tiling_and_blending_textures_are_named() {
         &["n.exr", "NaN", "textures.tb.deformation[0]"],
     );
     error_of(&with("exemplar = \"e\"\ncuts = \"dec.json\"", ""), files, &["textures.tb.cuts", "map factor"]);
+    // Chart maps: one channel of whole numbers, the F map's size; field_at needs a field.
+    let charted = |charts: &str| {
+        with(
+            &format!(
+                "exemplar = \"e\"\nfield_at = \"tile_centre\"\n\
+                 deformation = [{{ type = \"map\", filename = \"i.exr\", charts = \"{charts}\" }}]"
+            ),
+            "",
+        )
+    };
+    error_of(&charted("f.exr"), files, &["f.exr", "one channel", "textures.tb.deformation[0].charts"]);
+    error_of(&charted("e.png"), files, &["e.png", "the F map's size, 2x2"]);
+    error_of(
+        &with("exemplar = \"e\"\nfield_at = \"tile_centre\"", ""),
+        files,
+        &["textures.tb.field_at", "no deformation"],
+    );
+    error_of(&with("exemplar = \"e\"\nfield_at = \"corner\"", ""), files, &["unknown variant `corner`", "tile_centre"]);
     let mapped = |cuts: &str| {
         with(
             &format!("exemplar = \"e\"\ndeformation = [{{ type = \"map\", filename = \"i.exr\" }}]\ncuts = \"{cuts}\""),
@@ -698,12 +716,12 @@ fn failed_runs_leave_output_folders_as_they_were() {
     let run = tessera().current_dir(dir.path()).args(["deform", "flat.obj", "-o", "new"]).output().unwrap();
     assert_eq!(run.status.code(), Some(1));
     assert!(!dir.path().join("new").exists());
-    // With the obstacle gone, all five files are written.
+    // With the obstacle gone, all six files are written.
     std::fs::remove_dir(out.join("orientation.png")).unwrap();
     let run = tessera().current_dir(dir.path()).args(["deform", "m.obj", "--res", "16", "-o", "out"]).output().unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     assert_ne!(std::fs::read(out.join("f_map.exr")).unwrap(), b"the good map");
-    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 5);
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 6);
 }
 
 #[test]

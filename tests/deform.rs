@@ -7,6 +7,13 @@ mod common;
 use glam::{Mat2, Vec2, Vec3};
 use tessera::deform::{Orientation, Smoothing, deformation_maps};
 use tessera::geometry::TriangleMesh;
+use tessera::texture::tiling_blending::FieldAt;
+
+/// Fold-over of the tiles' lookups of `maps`, read at the point, for centres 0.05 away.
+fn point_fold(maps: &tessera::deform::DeformationMaps) -> tessera::deform::analysis::FoldOver {
+    let charts = maps.chart_of_texels();
+    tessera::deform::analysis::fold_over(&maps.f_map, &maps.coverage, &charts, 0.05, FieldAt::Point)
+}
 
 /// A strip of a cylinder of radius 0.5 about y (angles 0 to 1.6, height 0 to 0.8), unrolled
 /// isometrically: u is the arc length along the polyline of chords (so that every flat triangle
@@ -117,6 +124,10 @@ fn cli_writes_the_f_map_and_pictures() {
     let f = tessera::image::read_bitmap(&out.join("f_map.exr"), tessera::image::ColorSpace::Linear).unwrap();
     assert_eq!((f.width, f.height, f.channels), (32, 32, 4));
     assert!(["det_f.png", "orientation.png", "cut_bands.png"].iter().all(|p| out.join(p).exists()));
+    // The chart map: one channel, the F map's size; the strip is one chart.
+    let charts = tessera::image::read_bitmap_raw(&out.join("charts.exr"), tessera::image::ColorSpace::Linear).unwrap();
+    assert_eq!((charts.width, charts.height, charts.channels), (32, 32, 1));
+    assert!(charts.data.iter().all(|&c| c == 0.0));
     // One chart, no cuts: a cuts file without curves.
     let cuts = std::fs::read_to_string(out.join("cuts.json")).unwrap();
     assert!(tessera::texture::tiling_blending::cuts_from_json(&cuts).unwrap().is_empty(), "{cuts}");
@@ -148,7 +159,7 @@ fn the_field_compensates_a_lat_long_sphere_distortion() {
     assert!(classical.mean_anisotropy > 1.3 && classical.std_log_area > 0.3, "{classical:?}");
     assert!(deformed.mean_anisotropy < 1.05, "{deformed:?}");
     assert!(deformed.std_log_area < 0.2 * classical.std_log_area, "{deformed:?}");
-    let fold = tessera::deform::analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), 0.05);
+    let fold = point_fold(&maps);
     assert_eq!(fold.folded, 0.0, "{fold:?}");
 }
 
@@ -291,7 +302,7 @@ fn triangles_own_fields_match_their_jacobians_but_tear_the_lookups() {
         let maps = deformation_maps(&mesh, &Orientation::Uv, smoothing, 512, 0.05).unwrap();
         let f = tessera::texture::tiling_blending::Deformation::Map(tessera::texture::MipMap::new(maps.f_map.clone()));
         let distortion = tessera::deform::distortion(&mesh, |uv| f.at(uv)).unwrap();
-        let fold = tessera::deform::analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), 0.05);
+        let fold = point_fold(&maps);
         (distortion, fold)
     };
     let (own, own_fold) = analyse(Smoothing::Triangles);

@@ -571,3 +571,61 @@ fn the_lattice_shows_where_mix_max_lets_the_tiles_centres_win_and_nowhere_else()
     assert!(histogram < 1.5 && high < 2.0, "{histogram} {high}");
     assert!(low > 5.0 && low > 10.0 * high, "{low} {high}");
 }
+
+#[test]
+fn tiles_that_read_the_field_at_their_centres_are_affine_and_keep_to_their_chart() {
+    // F turns fast along u (a rotation by 40 u radians): read at the point, a tile's lookup
+    // u -> F(u)(u - c) + h bends (its finite-difference Jacobian is not F(u)); read at the
+    // centre, it is F(c) exactly, whatever u in the tile.
+    use tessera::texture::tiling_blending::{Charts, FieldAt};
+    let turning = vec![Deformation::Rotation { angle: 0.0, gradient: Vec2::new(40.0, 0.0) }];
+    let at = |field_at: FieldAt, charts: Option<Charts>| Synthesis {
+        deformation: Some(DeformationField::new(turning.clone()).read_at(field_at, charts)),
+        ..(*synthesis(Tiling::Hexagonal, Blend::Linear, None)).clone()
+    };
+    let tiles = |s: &Synthesis, uv: Vec2| s.lookups(&TexCtx { uv, ..Default::default() }).0;
+    let rotation = |a: f32| Mat2::from_angle(a);
+    let (uv, h) = (Vec2::new(0.413, 0.371), 1e-3);
+    let centre_read = at(FieldAt::TileCentre, None);
+    let point_read = at(FieldAt::Point, None);
+    let tiling = Tiling::Hexagonal.tiles(uv, 0.25);
+    for (i, tile) in tiling.iter().take(3).enumerate() {
+        let jacobian = |s: &Synthesis| {
+            let du =
+                (tiles(s, uv + Vec2::new(h, 0.0))[i].ctx.uv - tiles(s, uv - Vec2::new(h, 0.0))[i].ctx.uv) / (2.0 * h);
+            let dv =
+                (tiles(s, uv + Vec2::new(0.0, h))[i].ctx.uv - tiles(s, uv - Vec2::new(0.0, h))[i].ctx.uv) / (2.0 * h);
+            Mat2::from_cols(du, dv)
+        };
+        let expected = rotation(40.0 * tile.centre.x);
+        let off = (jacobian(&centre_read) - expected).to_cols_array().iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        assert!(off < 2e-3, "tile {i}: {:?} against F(c) {expected:?}", jacobian(&centre_read));
+        // At the point, the Jacobian is F(u) + dF (u - c): off F(u) by 40 |u - c|.
+        let bend =
+            (jacobian(&point_read) - rotation(40.0 * uv.x)).to_cols_array().iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        assert!(bend > 1.0, "tile {i}: the point's lookup bends by {bend}");
+    }
+    // Two charts, split at u = 0.5: a point of the left chart reads, for a tile centred in the
+    // right one, F at the left chart's point nearest to the centre (just left of u = 0.5).
+    let mut map = Bitmap::new(64, 64, 1);
+    map.data.iter_mut().enumerate().for_each(|(k, c)| *c = if k % 64 >= 32 { 1.0 } else { 0.0 });
+    let charted = at(FieldAt::TileCentre, Some(Charts::new(&map, 0.25)));
+    let near_cut = Vec2::new(0.49, 0.3);
+    let field = charted.deformation.as_ref().unwrap();
+    let mut crossed = 0;
+    for tile in Tiling::Hexagonal.tiles(near_cut, 0.25).iter().take(3) {
+        let p = field.tile_field_point(tile.centre, near_cut).unwrap();
+        if tile.centre.x >= 0.5 && tile.centre.x < 1.0 {
+            crossed += 1;
+            assert!((p.x - 31.5 / 64.0).abs() < 1e-5, "tile at {}: F read at {p}", tile.centre);
+        } else {
+            assert_eq!(p, tile.centre);
+        }
+    }
+    assert!(crossed > 0, "a tile around {near_cut} is centred across u = 0.5");
+    // The WGSL port reads F at the point, and says so.
+    let exemplar = image_texture(8, vec![0.5; 64], Filter::None);
+    let texture = TilingBlending::new(Arc::new(centre_read), exemplar).unwrap();
+    let refusal = texture.gpu_synthesis().err().expect("not ported");
+    assert!(refusal.contains("tile_centre"), "{refusal}");
+}

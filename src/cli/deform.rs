@@ -15,7 +15,7 @@ use tessera::files::StagedFolder;
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
 use tessera::limits;
-use tessera::texture::tiling_blending::{Deformation, DeformationField, cuts_to_json};
+use tessera::texture::tiling_blending::{Deformation, DeformationField, FieldAt, cuts_to_json};
 use tessera::texture::{Filter, ImageTexture, MipMap, Texture};
 
 /// The mesh and the parameters of its deformation field.
@@ -171,17 +171,19 @@ fn print_distortion(classical: Option<Distortion>, deformed: Option<Distortion>)
 pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     let (mesh, maps, _, [loaded, computed]) = args.maps()?;
     // (`analyze` prints the fold-over among its figures.)
-    let fold = analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), args.tile_size);
+    let fold =
+        analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), args.tile_size, FieldAt::Point);
     if fold.folded > 0.01 {
         eprintln!(
             "warning: {}: tiles of {} fold their lookups F(u)(u - c) on {:.1}% of the texels (F varies across a tile \
-             faster than a tile can follow: the texture tears there); smaller tiles fold less",
+             faster than a tile can follow: the texture tears there); smaller tiles fold less, and tiles that read F \
+             at their centres (field_at = \"tile_centre\", with charts = \"charts.exr\") never fold",
             args.mesh.display(),
             args.tile_size,
             100.0 * fold.folded
         );
     }
-    // All five files or none: a failure halfway leaves the folder as it was.
+    // All six files or none: a failure halfway leaves the folder as it was.
     let staged = StagedFolder::new(output)?;
     let write_map = |name: &str, map: &tessera::image::Bitmap| {
         let plane = |c: usize| map.data.iter().skip(c).step_by(4).copied().collect::<Vec<f32>>();
@@ -189,6 +191,8 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         write_exr(&staged.path().join(name), map.width, map.height, channels)
     };
     write_map("f_map.exr", &maps.f_map)?;
+    let charts = maps.chart_map();
+    write_exr(&staged.path().join("charts.exr"), charts.width, charts.height, vec![("Y".into(), charts.data)])?;
     let cuts_file = staged.path().join("cuts.json");
     std::fs::write(&cuts_file, cuts_to_json(maps.bands.curves())).map_err(|e| Error::io(&cuts_file, e))?;
     let (det, orientation_picture) = tessera::deform::f_map_pictures(&maps.f_map);
@@ -203,7 +207,7 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         "{}: {} triangles ({} mirrored in UV) in {} charts, smoothing {} ({} texels outside every triangle, \
          extrapolated from the nearest), \
          {} cut edges in {} cuts (bands for tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
-         wrote f_map.exr, cuts.json, det_f.png, orientation.png, cut_bands.png to {}",
+         wrote f_map.exr, charts.exr, cuts.json, det_f.png, orientation.png, cut_bands.png to {}",
         args.mesh.display(),
         mesh.indices.len(),
         maps.mirrored,
@@ -293,12 +297,15 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
         );
     }
     println!(
-        "fold-over of the tiles' lookups F(u)(u - c), tile centres {} away: {:.3}% of {} texels fold, {:.3}% stretch \
-         beyond 2:1; UV area covered more than once: {:.3}%",
+        "fold-over of the tiles' lookups, tile centres {} away, over {} texels: F(u)(u - c) (field_at = \"point\") \
+         {:.3}% fold, {:.3}% stretch beyond 2:1; F(c)(u - c) (\"tile_centre\") {:.3}% fold, {:.3}% stretch; \
+         UV area covered more than once: {:.3}%",
         args.tile_size,
-        100.0 * a.fold_over.folded,
         a.fold_over.texels,
+        100.0 * a.fold_over.folded,
         100.0 * a.fold_over.stretched,
+        100.0 * a.fold_over_at_centres.folded,
+        100.0 * a.fold_over_at_centres.stretched,
         100.0 * a.uv_overlap
     );
     Ok(ExitCode::SUCCESS)

@@ -110,11 +110,14 @@ enum Command {
         #[arg(required = true)]
         images: Vec<PathBuf>,
         /// Images per row.
-        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=1024))]
+        #[arg(long, visible_alias = "cols", default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=1024))]
         columns: u32,
         /// A caption per image, in order (default: the files' names without extension).
         #[arg(long = "label")]
         labels: Vec<String>,
+        /// All the captions after one flag, in order (after the images: `--labels a b c`).
+        #[arg(long = "labels", num_args = 1.., conflicts_with = "labels")]
+        label_list: Vec<String>,
         /// Output image (.png or .exr).
         #[arg(short, long)]
         output: PathBuf,
@@ -185,8 +188,9 @@ enum Command {
         command: gpu::ShaderCommand,
     },
     /// Derive the deformation field of a UV-mapped mesh (paper 000 Sec. 4) and its UV cuts:
-    /// writes f_map.exr (F00, F01, F10, F11), cuts.json (the cut curves the synthesis' cut
-    /// bands follow) and pictures of |det F|, the orientation and the cut bands.
+    /// writes f_map.exr (F00, F01, F10, F11), charts.exr (each texel's UV chart), cuts.json (the
+    /// cut curves the synthesis' cut bands follow) and pictures of |det F|, the orientation and
+    /// the cut bands.
     Deform {
         #[command(flatten)]
         mesh: deform::MeshArgs,
@@ -292,8 +296,8 @@ pub fn run() -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Regress(args) => regress::run(&args),
-        Command::Montage { images, columns, labels, output } => {
-            montage(&images, columns as usize, &labels, &output)?;
+        Command::Montage { images, columns, labels, label_list, output } => {
+            montage(&images, columns as usize, if label_list.is_empty() { &labels } else { &label_list }, &output)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Seams { render, jump } => {

@@ -15,13 +15,13 @@
 //!   Measured on the F map's texels inside UV triangles.
 //! - **distortion**: [`super::distortion`], classical and deformed.
 
+use super::fold::{DIRECTIONS, LookupFold, centred_fold, lookup_fold};
 use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion};
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
-use crate::math::largest_singular_value;
 use crate::texture::tiling_blending::{
-    Blend, CutBands, Deformation, DeformationField, Synthesis, Tiling, synthesis_lattice_visibility,
+    Blend, Charts, CutBands, Deformation, DeformationField, FieldAt, Synthesis, Tiling, synthesis_lattice_visibility,
 };
 use crate::texture::{MipMap, TexCtx, Texture, TilingBlending};
 use glam::{Mat2, Vec2, Vec3};
@@ -141,16 +141,16 @@ pub struct FoldOver {
     pub texels: usize,
 }
 
-/// Directions of tile centres tried around each texel.
-const FOLD_DIRECTIONS: usize = 8;
-
 /// The fold-over of the F map `f_map` (4 channels, row 0 at v = 1) for tiles whose centres
-/// lie `reach` UV units away (the tile's support radius), on the texels that `covered` marks
+/// lie `reach` UV units away (the tile's support radius) in [`super::fold::DIRECTIONS`]
+/// directions, their lookups reading F as `field_at` says, on the texels that `covered` marks
 /// (row-major from the bottom row, as [`super::uv_coverage`] and [`DeformationMaps::coverage`]
-/// give them). dF comes from central differences of neighbouring texels of the same chart
-/// (`chart`, row-major from the bottom row; one-sided at a chart's or the map's border), since
-/// a tile never reads across charts.
-pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32) -> FoldOver {
+/// give them). Read at the point, dF comes from central differences of neighbouring texels of
+/// the same chart (`chart`, row-major from the bottom row; one-sided at a chart's or the map's
+/// border), since a tile never reads across charts. Read at tile centres, F(c) is the texel at
+/// the centre where it lies in the texel's chart, and the point's criterion applies where some
+/// centre does not (the renderer reads F(u) there).
+pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32, field_at: FieldAt) -> FoldOver {
     let res = f_map.width;
     let f = |i: usize, j: usize| {
         // j counts rows from the bottom (v up).
@@ -173,36 +173,47 @@ pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32) -> F
         let span = if along_u { hi.0 - lo.0 } else { hi.1 - lo.1 };
         if span == 0 { Mat2::ZERO } else { (f(hi.0, hi.1) - f(lo.0, lo.1)) * (res as f32 / span as f32) }
     };
+    // Read at tile centres: where each centre around (i, j) reads F, as the renderer does
+    // (Charts); the worst over the centres, None if one has no point of the chart in reach.
+    let charts = (field_at == FieldAt::TileCentre).then(|| {
+        let mut map = Bitmap::new(res, res, 1);
+        for (k, c) in chart.iter().enumerate() {
+            map.values_mut(k % res, res - 1 - k / res)[0] = *c as f32;
+        }
+        Charts::new(&map, reach)
+    });
+    let texel_at = |uv: Vec2| {
+        let p = (uv - crate::math::floor2(uv)) * res as f32;
+        ((p.x as usize).min(res - 1), (p.y as usize).min(res - 1))
+    };
+    let centred = |i: usize, j: usize| {
+        let charts = charts.as_ref()?;
+        let u = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
+        let mut worst = LookupFold::Fine;
+        for k in 0..DIRECTIONS {
+            let d = Vec2::from_angle(k as f32 * std::f32::consts::TAU / DIRECTIONS as f32) * reach;
+            let (ci, cj) = texel_at(charts.field_point(u - d, chart[j * res + i])?);
+            worst = worst.max(centred_fold(f(i, j), f(ci, cj))?);
+        }
+        Some(worst)
+    };
     let (mut folded, mut stretched, mut texels) = (0usize, 0usize, 0usize);
     for j in 0..res {
         for i in 0..res {
             if covered[j * res + i] == 0 {
                 continue;
             }
-            let fu = f(i, j);
-            let det = fu.determinant();
-            if !(det.abs() > 1e-12) {
-                continue;
-            }
-            texels += 1;
-            let (du, dv) = (derivative(i, j, true), derivative(i, j, false));
-            let inverse = fu.inverse();
-            let (mut fold, mut stretch) = (false, false);
-            for k in 0..FOLD_DIRECTIONS {
-                let d = Vec2::from_angle(k as f32 * std::f32::consts::TAU / FOLD_DIRECTIONS as f32) * reach;
-                // d/du_k of F(u)(u - c) = F e_k + (dF/du_k)(u - c), u - c = d.
-                let jacobian = Mat2::from_cols(fu.x_axis + du * d, fu.y_axis + dv * d);
-                if !(jacobian.determinant() / det > 0.0) {
-                    fold = true;
-                    break;
+            let outcome = match centred(i, j) {
+                Some(outcome) => outcome,
+                None => {
+                    let (du, dv) = (derivative(i, j, true), derivative(i, j, false));
+                    let Some(outcome) = lookup_fold(f(i, j), du, dv, reach) else { continue };
+                    outcome
                 }
-                // Singular values of the lookup's change against F's: s_max s_min = |det|.
-                let relative = jacobian * inverse;
-                let s_max = largest_singular_value(relative);
-                stretch |= s_max > 2.0 || relative.determinant().abs() / s_max < 0.5;
-            }
-            folded += usize::from(fold);
-            stretched += usize::from(stretch && !fold);
+            };
+            texels += 1;
+            folded += usize::from(outcome == LookupFold::Folded);
+            stretched += usize::from(outcome == LookupFold::Stretched);
         }
     }
     let fraction = |n: usize| if texels == 0 { 0.0 } else { n as f64 / texels as f64 };
@@ -239,8 +250,10 @@ pub struct Analysis {
     pub seam_samples: usize,
     /// Angle between the deformed texture's x axis and the orientation field.
     pub orientation_error: Option<AngleError>,
-    /// Fold-over of the tiles' lookups through the F map.
+    /// Fold-over of the tiles' lookups through the F map, read at the point (Eq. 3).
     pub fold_over: FoldOver,
+    /// The same, the tiles reading F at their centres ([`FieldAt::TileCentre`]).
+    pub fold_over_at_centres: FoldOver,
     /// Fraction of the UV area covered more than once.
     pub uv_overlap: f64,
     /// How visible the paving's lattice is in the classical synthesis of the exemplar (F = I;
@@ -316,6 +329,7 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
             })
         })
         .transpose()?;
+    let charts = maps.chart_of_texels();
     Ok(Analysis {
         triangles: mesh.indices.len(),
         cut_edges: edges,
@@ -328,7 +342,8 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
             field.at_surface(uv, Some(mirrored))
         }),
         // A hexagonal tile reaches one lattice spacing from its centre.
-        fold_over: fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), input.tile_size),
+        fold_over: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::Point),
+        fold_over_at_centres: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::TileCentre),
         uv_overlap: maps.overlap().fraction(),
         lattice_visibility,
     })
@@ -357,17 +372,48 @@ mod tests {
         let (res, r) = (64, 0.1);
         let covered = vec![1u8; res * res];
         let one_chart = vec![0u32; res * res];
-        let slow = fold_over(&turning_map(res, 1.0), &covered, &one_chart, r);
+        let slow = fold_over(&turning_map(res, 1.0), &covered, &one_chart, r, FieldAt::Point);
         assert_eq!((slow.folded, slow.stretched, slow.texels), (0.0, 0.0, res * res));
-        let fast = fold_over(&turning_map(res, 30.0), &covered, &one_chart, r);
+        let fast = fold_over(&turning_map(res, 30.0), &covered, &one_chart, r, FieldAt::Point);
         assert!(fast.folded > 0.9, "{fast:?}");
         // Uncovered texels are not measured.
-        assert_eq!(fold_over(&turning_map(res, 30.0), &vec![0u8; res * res], &one_chart, r).texels, 0);
+        assert_eq!(fold_over(&turning_map(res, 30.0), &vec![0u8; res * res], &one_chart, r, FieldAt::Point).texels, 0);
         // Every texel its own chart: no neighbour to differentiate with, nothing folds.
         let apart: Vec<u32> = (0..(res * res) as u32).collect();
-        assert_eq!(fold_over(&turning_map(res, 30.0), &covered, &apart, r).folded, 0.0);
+        assert_eq!(fold_over(&turning_map(res, 30.0), &covered, &apart, r, FieldAt::Point).folded, 0.0);
         // Between: stretched beyond 2:1 (k r = 0.6 gives a relative determinant of 0.4).
-        let middle = fold_over(&turning_map(res, 6.0), &covered, &one_chart, r);
+        let middle = fold_over(&turning_map(res, 6.0), &covered, &one_chart, r, FieldAt::Point);
         assert!(middle.folded == 0.0 && middle.stretched > 0.9, "{middle:?}");
+    }
+
+    #[test]
+    fn tiles_that_read_the_field_at_their_centres_never_fold() {
+        // F(c)(u - c) is affine in u: with F a rotation everywhere, it never folds, and it
+        // stretches only against F(u) (never: F(c) F(u)^-1 is a rotation too), however fast F
+        // turns. Centres off the map or in another chart fall back to the point's criterion.
+        let (res, r) = (64, 0.1);
+        let covered = vec![1u8; res * res];
+        let one_chart = vec![0u32; res * res];
+        let fast = fold_over(&turning_map(res, 30.0), &covered, &one_chart, r, FieldAt::TileCentre);
+        assert_eq!(fast.texels, res * res);
+        // Only texels within r of the map's border (some centre off the map) can fold.
+        let border = 1.0 - (1.0 - 2.0 * r as f64).powi(2);
+        assert!(fast.folded <= border + 0.02, "{fast:?}");
+        assert_eq!(fast.stretched, 0.0, "{fast:?}");
+        // A field that scales by 3 across a tile stretches beyond 2:1, without folding.
+        let mut scaling = Bitmap::new(res, res, 4);
+        for (n, px) in scaling.data.chunks_exact_mut(4).enumerate() {
+            let s = (3.0f32.ln() / r * ((n % res) as f32 + 0.5) / res as f32).exp();
+            px.copy_from_slice(&[s, 0.0, 0.0, s]);
+        }
+        let scaled = fold_over(&scaling, &covered, &one_chart, r, FieldAt::TileCentre);
+        assert!(scaled.stretched > 0.5 && scaled.folded <= border + 0.02, "{scaled:?}");
+        // A reflection in the centre's F against a rotation at u folds.
+        let mut mirrored = turning_map(res, 0.0);
+        for px in mirrored.data.chunks_exact_mut(4).skip(res / 2).step_by(res) {
+            px[3] = -1.0;
+        }
+        let torn = fold_over(&mirrored, &covered, &one_chart, r, FieldAt::TileCentre);
+        assert!(torn.folded > 0.0, "{torn:?}");
     }
 }

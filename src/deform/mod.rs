@@ -7,6 +7,7 @@ pub mod analysis;
 mod cuts;
 mod distortion;
 mod field;
+mod fold;
 mod geodesic;
 mod gradient;
 mod nearest;
@@ -116,6 +117,18 @@ impl DeformationMaps {
     /// bottom row).
     pub fn chart_of_texels(&self) -> Vec<u32> {
         self.raster.owner.iter().map(|&t| self.field.chart_of_triangle[t as usize]).collect()
+    }
+
+    /// The chart map: each texel's chart number as one channel, row 0 at the top (v = 1) as the
+    /// F map; the scene's `charts` for tiles that read F at their centres.
+    pub fn chart_map(&self) -> Bitmap {
+        let res = self.raster.res;
+        let charts = self.chart_of_texels();
+        let mut map = Bitmap::new(res, res, 1);
+        for (k, c) in charts.iter().enumerate() {
+            map.values_mut(k % res, res - 1 - k / res)[0] = *c as f32;
+        }
+        map
     }
 
     /// How much of the UV square more than one triangle covers, at the maps' resolution.

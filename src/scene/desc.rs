@@ -221,6 +221,9 @@ pub struct TilingBlendingDesc {
     /// laid along it, read alike from both sides, so that the texture continues across the cut
     /// (DESIGN.md section 6). Needs a `map` factor in `deformation`.
     pub cuts: Option<String>,
+    /// Where each tile reads the deformation field: `point` (F(u), the paper's Eq. 3; default)
+    /// or `tile_centre` (F(c_i): each tile affine, never folding).
+    pub field_at: Option<crate::texture::tiling_blending::FieldAt>,
 }
 
 /// A scale: one number for both axes, or [along u, along v].
@@ -289,6 +292,10 @@ pub enum DeformationDesc {
     Map {
         /// The EXR file.
         filename: String,
+        /// Its UV charts, a one-channel image of chart numbers of the same size (`charts.exr`
+        /// from `tessera deform`): where tiles read F at their centres, a centre in another chart
+        /// than the point reads F at the point instead.
+        charts: Option<String>,
     },
 }
 

@@ -21,7 +21,7 @@ use crate::material::{
 };
 use crate::pups::{PresetParams, PupsTexture, read_points};
 use crate::texture::tiling_blending::{
-    Blend, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
+    Blend, Charts, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
 };
 use crate::texture::{ImageTexture, MipMap, PupsLookup, QuadTilesTexture, Texture, TilingBlending};
 use glam::{Mat2, Mat4, Vec2, Vec3};
@@ -461,6 +461,7 @@ impl<'a> Loader<'a> {
                 ("contrast", d.contrast.is_some()),
                 ("deformation", d.deformation.is_some()),
                 ("cuts", d.cuts.is_some()),
+                ("field_at", d.field_at.is_some()),
             ];
             if let Some((key, _)) = own.iter().find(|(_, set)| *set) {
                 return Err(
@@ -531,14 +532,28 @@ impl<'a> Loader<'a> {
             }
         };
         let deformation = match &d.deformation {
+            None if d.field_at.is_some() => {
+                return Err(self.error(format!("{item}.field_at: there is no deformation field to read")));
+            }
             None => None,
-            Some(factors) => Some(DeformationField::new(
-                factors
+            Some(factors) => {
+                let factors = factors
                     .iter()
                     .enumerate()
                     .map(|(i, f)| self.deformation(f, &format!("{item}.deformation[{i}]")))
-                    .collect::<Result<_>>()?,
-            )),
+                    .collect::<Result<Vec<_>>>()?;
+                let charts = self.chart_map(factors.as_slice(), &d.deformation, &item)?;
+                let reach = d
+                    .tiling
+                    .unwrap_or(Tiling::Hexagonal)
+                    .support_corners()
+                    .iter()
+                    .map(|c| c.length())
+                    .fold(0.0, f32::max)
+                    * tile_size;
+                let charts = charts.map(|map| Charts::new(&map, reach));
+                Some(DeformationField::new(factors).read_at(d.field_at.unwrap_or_default(), charts))
+            }
         };
         let cuts = match &d.cuts {
             None => None,
@@ -567,6 +582,41 @@ impl<'a> Loader<'a> {
         });
         self.syntheses.insert(name.to_string(), synthesis.clone());
         Ok(synthesis)
+    }
+
+    /// The chart map of a deformation's first F map factor (`charts`), checked against it: one
+    /// channel, its size, whole numbers.
+    fn chart_map(
+        &self,
+        factors: &[Deformation],
+        descs: &Option<Vec<DeformationDesc>>,
+        item: &str,
+    ) -> Result<Option<crate::image::Bitmap>> {
+        let Some(descs) = descs else { return Ok(None) };
+        let Some((i, filename, f_map)) =
+            descs.iter().zip(factors).enumerate().find_map(|(i, (desc, f))| match (desc, f) {
+                (DeformationDesc::Map { charts: Some(file), .. }, Deformation::Map(map)) => {
+                    Some((i, file, map.level(0)))
+                }
+                _ => None,
+            })
+        else {
+            return Ok(None);
+        };
+        let item = format!("{item}.deformation[{i}].charts");
+        let file = self.resolve_path(filename);
+        let charts = read_bitmap_raw(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, &item))?;
+        if charts.channels != 1 || (charts.width, charts.height) != (f_map.width, f_map.height) {
+            let msg = format!(
+                "a chart map needs one channel and the F map's size, {}x{}: found {}x{} with {} channels",
+                f_map.width, f_map.height, charts.width, charts.height, charts.channels
+            );
+            return Err(Error::image(&file, msg).in_scene(self.path, &item));
+        }
+        if !charts.data.iter().all(|c| c.is_finite() && *c >= 0.0 && c.fract() == 0.0) {
+            return Err(Error::image(&file, "chart numbers must be whole numbers >= 0").in_scene(self.path, &item));
+        }
+        Ok(Some(charts))
     }
 
     /// One factor of a deformation field.
@@ -603,7 +653,7 @@ impl<'a> Loader<'a> {
                 }
                 Deformation::Shear { shear: *shear, gradient: Vec2::from(*gradient) }
             }
-            DeformationDesc::Map { filename } => {
+            DeformationDesc::Map { filename, .. } => {
                 let file = self.resolve_path(filename);
                 // Signed data: F maps have negative entries.
                 let bitmap = read_bitmap_raw(&file, ColorSpace::Linear).map_err(|e| e.in_scene(self.path, item))?;

@@ -82,16 +82,70 @@ fn with_handedness(m: Mat2, uv_mirrored: Option<bool>) -> Mat2 {
     if uv_mirrored.is_some_and(|mirrored| (m.determinant() < 0.0) != mirrored) { crate::math::MIRROR * m } else { m }
 }
 
-/// A deformation field: the product F = F_1 F_2 ... F_n of its factors (identity when empty).
+/// Where each tile of the paving reads the field.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FieldAt {
+    /// At the point: tile i reads the exemplar at F(u)(u - c_i) + h_i (paper 000 Eq. 3). Its
+    /// Jacobian F(u) + dF (u - c_i) folds where F varies faster than a tile spans (the paper's
+    /// open "cracks"; `tessera analyze` measures where).
+    #[default]
+    Point,
+    /// At the tile's centre: F(c_i)(u - c_i) + h_i, an affine image of the exemplar per tile,
+    /// which never folds; each tile carries the field of its centre, off F(u) by dF (c_i - u)
+    /// (what `analyze` reports as stretch). Where c_i lies in another UV chart than u (the
+    /// chart map that `tessera deform` writes), the tile reads u's chart's field at the chart's
+    /// point nearest to c_i ([`super::Charts`]), and F(u) if no point of the chart is within
+    /// reach of c_i.
+    TileCentre,
+}
+
+/// A deformation field: the product F = F_1 F_2 ... F_n of its factors (identity when empty),
+/// and where tiles read it.
 #[derive(Clone, Debug, Default)]
 pub struct DeformationField {
     factors: Vec<Deformation>,
+    field_at: FieldAt,
+    /// The UV charts of the F map, for [`FieldAt::TileCentre`]; None: one chart.
+    charts: Option<std::sync::Arc<super::Charts>>,
 }
 
 impl DeformationField {
-    /// The field F_1 F_2 ... F_n.
+    /// The field F_1 F_2 ... F_n, read at the point.
     pub fn new(factors: Vec<Deformation>) -> Self {
-        DeformationField { factors }
+        DeformationField { factors, field_at: FieldAt::Point, charts: None }
+    }
+
+    /// This field read by the tiles at `field_at`, with the UV charts `charts` for
+    /// [`FieldAt::TileCentre`].
+    pub fn read_at(self, field_at: FieldAt, charts: Option<super::Charts>) -> Self {
+        DeformationField { field_at, charts: charts.map(std::sync::Arc::new), ..self }
+    }
+
+    /// Where tiles read the field.
+    pub fn field_at(&self) -> FieldAt {
+        self.field_at
+    }
+
+    /// Where the tile centred at `centre` reads F for the point `uv`: None at the point;
+    /// read at tile centres, the centre itself, or (in another chart than `uv`) the nearest
+    /// point of `uv`'s chart ([`super::Charts::field_point`]; None beyond reach).
+    #[inline]
+    pub fn tile_field_point(&self, centre: Vec2, uv: Vec2) -> Option<Vec2> {
+        match (self.field_at, &self.charts) {
+            (FieldAt::Point, _) => None,
+            (FieldAt::TileCentre, None) => Some(centre),
+            (FieldAt::TileCentre, Some(charts)) => charts.field_point(centre, charts.chart(uv)),
+        }
+    }
+
+    /// The field that the tile centred at `centre` reads at `uv`, given F there (`f_at_uv`, as
+    /// [`DeformationField::at_surface`] gives it with `uv_mirrored`): F at
+    /// [`DeformationField::tile_field_point`] with the surface's handedness at `uv`, or
+    /// `f_at_uv` where that is None.
+    #[inline]
+    pub fn for_tile(&self, centre: Vec2, uv: Vec2, uv_mirrored: Option<bool>, f_at_uv: Mat2) -> Mat2 {
+        self.tile_field_point(centre, uv).map_or(f_at_uv, |p| self.at_surface(p, uv_mirrored))
     }
 
     /// F at `uv`.

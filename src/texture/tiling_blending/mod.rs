@@ -7,6 +7,7 @@
 //! material (albedo, roughness, normal, ...) share one `Arc<Synthesis>` so that they all see the
 //! same tiles, shifts and weights and stay registered (paper 000 Sec. 6.2).
 
+mod charts;
 mod cuts;
 mod deformation;
 mod histogram;
@@ -17,8 +18,9 @@ mod shift;
 mod synthesis;
 mod tiling;
 
+pub use charts::Charts;
 pub use cuts::{BANDS_PER_POINT, BandLookup, CutBands, CutCurve, CutPoint, cuts_from_json, cuts_to_json};
-pub use deformation::{Deformation, DeformationField, MAX_DEFORMATION};
+pub use deformation::{Deformation, DeformationField, FieldAt, MAX_DEFORMATION};
 pub use histogram::GaussianizedExemplar;
 pub use lattice::{lattice_frequencies, lattice_visibility, synthesis_lattice_visibility};
 pub use operators::{Blend, PriorityMap};

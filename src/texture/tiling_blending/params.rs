@@ -6,7 +6,7 @@
 //! lacks (cut bands, the sharpened operator, a procedural exemplar) gets an
 //! error naming it rather than a different image.
 
-use super::{Blend, Deformation, Exemplar, Tiling, TilingBlending, fold_seed};
+use super::{Blend, Deformation, Exemplar, FieldAt, Tiling, TilingBlending, fold_seed};
 use crate::image::Bitmap;
 use crate::texture::{Filter, ImageTexture, MipMap};
 use bytemuck::{Pod, Zeroable};
@@ -261,6 +261,9 @@ impl TilingBlending {
                 "the GPU port takes at most {MAX_GPU_FACTORS} deformation factors, this field has {}",
                 factors.len()
             ));
+        }
+        if s.deformation.as_ref().is_some_and(|d| d.field_at() == FieldAt::TileCentre) {
+            return Err("the GPU port reads F at the point; field_at = \"tile_centre\" is not ported".into());
         }
         let maps: Vec<&MipMap> =
             factors.iter().filter_map(|f| if let Deformation::Map(m) = f { Some(m) } else { None }).collect();

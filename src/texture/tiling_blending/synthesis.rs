@@ -1,6 +1,7 @@
 //! The synthesis of deformed tiling and blending (paper 000 Eq. 1-3 and Sec. 6.1): at a point u,
 //! the k tiles of the paving that cover it, each read at E(F(u) (u - c_i) + h_i) with the
-//! footprint F(u) du/dx, F(u) du/dy, and the cut bands' rows of tiles near a UV cut (Eq. 8,
+//! footprint F(u) du/dx, F(u) du/dy (or with F(c_i) in place of F(u): [`super::FieldAt`]), and
+//! the cut bands' rows of tiles near a UV cut (Eq. 8,
 //! [`CutBands`]). `shaders/tiling_blending/synthesis.wgsl` is the GPU port of this file.
 
 use super::shift::{cut_shift, shift};
@@ -75,11 +76,12 @@ impl Synthesis {
             let h = if self.inset { inset_shift(h, self.tile_reach(tile.centre)) } else { h };
             let offset = ctx.uv - tile.centre;
             out[i].weight = tile.weight;
-            out[i].ctx = match f {
-                None => TexCtx { uv: offset + h, uv_mirrored: None, ..*ctx },
-                Some(f) => {
+            out[i].ctx = match (f, &self.deformation) {
+                (Some(f), Some(field)) => {
+                    let f = field.for_tile(tile.centre, ctx.uv, ctx.uv_mirrored, f);
                     TexCtx { uv: f * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy, uv_mirrored: None }
                 }
+                _ => TexCtx { uv: offset + h, uv_mirrored: None, ..*ctx },
             };
         }
         let count = k + self.band_lookups(ctx, f.unwrap_or(Mat2::IDENTITY), &mut out);
