@@ -57,6 +57,11 @@ enum Command {
         /// `tessera diff --variance` takes it.
         #[arg(long)]
         variance: bool,
+        /// Replace a scene value before loading: KEY is a dotted path into the scene file
+        /// (`camera.fov`, `render.width`, `shapes[0].filename`), VALUE a TOML value (text that is
+        /// none is a string). Repeatable.
+        #[arg(long = "set", value_name = "KEY=VALUE", value_parser = key_value)]
+        set: Vec<(String, String)>,
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
@@ -260,8 +265,8 @@ impl From<FootprintArg> for BakeFootprint {
 /// Parse the command line and run it.
 pub fn run() -> Result<ExitCode> {
     match Cli::parse().command {
-        Command::Render { scene, output, spp, threads, seed, crop, aov, variance, quiet } => {
-            let overrides = SceneOverrides { spp, seed, ..Default::default() };
+        Command::Render { scene, output, spp, threads, seed, crop, aov, variance, set, quiet } => {
+            let overrides = SceneOverrides { spp, seed, set, ..Default::default() };
             let output = output.unwrap_or_else(|| default_output(&scene));
             tessera::image::OutputFormat::from_path(&output)?;
             let scene = load(&scene, &overrides, quiet)?;
@@ -425,6 +430,12 @@ fn load(path: &Path, overrides: &SceneOverrides, quiet: bool) -> Result<Scene> {
         }
     }
     Ok(scene)
+}
+
+/// `KEY=VALUE` of `--set`.
+fn key_value(text: &str) -> std::result::Result<(String, String), String> {
+    let (key, value) = text.split_once('=').ok_or_else(|| format!("'{text}' is not KEY=VALUE"))?;
+    Ok((key.trim().to_string(), value.trim().to_string()))
 }
 
 fn parse_crop(text: &str, scene: &Scene) -> Result<Crop> {

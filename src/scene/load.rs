@@ -38,7 +38,7 @@ const MAX_IOR: f32 = 10.0;
 const MAX_RADIANCE: f32 = 1e15;
 
 /// Settings given on the command line that replace the scene file's.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct SceneOverrides {
     /// Samples per pixel.
     pub spp: Option<u32>,
@@ -50,6 +50,9 @@ pub struct SceneOverrides {
     pub height: Option<u32>,
     /// Path length (-1 unlimited).
     pub max_depth: Option<i64>,
+    /// Any scene values, replaced before the scene is read: (key path, TOML value), as
+    /// [`super::set::set_value`] takes them (`--set camera.fov=40`).
+    pub set: Vec<(String, String)>,
 }
 
 /// Load a scene file.
@@ -60,7 +63,7 @@ pub fn load_scene(path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
 
 /// Load a scene from its text; `path` names it in messages and anchors its relative paths.
 pub fn load_scene_str(text: &str, path: &Path, overrides: &SceneOverrides) -> Result<Scene> {
-    let desc = parse_scene(text, path)?;
+    let desc = parse_scene(text, path, &overrides.set)?;
     Loader::new(path, &desc).load(&desc, overrides)
 }
 
@@ -69,15 +72,26 @@ fn read_scene_file(path: &Path) -> Result<String> {
     read_text_bounded(path, limits::MAX_SCENE_FILE_BYTES, "a scene file")
 }
 
-/// Parse a scene file's text; errors give the line, or the key of a number that is not finite.
-fn parse_scene(text: &str, path: &Path) -> Result<SceneDesc> {
+/// Parse a scene file's text with the values `set` replaced; errors give the line, or the key
+/// of a number that is not finite.
+fn parse_scene(text: &str, path: &Path, set: &[(String, String)]) -> Result<SceneDesc> {
     let syntax_error = |e: toml::de::Error| {
         let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
         Error::Scene { path: path.to_path_buf(), line, msg: e.message().to_string() }
     };
-    let table: toml::Table = toml::from_str(text).map_err(syntax_error)?;
-    check_numbers(&toml::Value::Table(table), "").map_err(|msg| Error::scene(path, msg))?;
-    toml::from_str(text).map_err(syntax_error)
+    let mut table: toml::Table = toml::from_str(text).map_err(syntax_error)?;
+    for (key, value) in set {
+        super::set::set_value(&mut table, key, value).map_err(|msg| Error::param(format!("--set {key}"), msg))?;
+    }
+    let table = toml::Value::Table(table);
+    check_numbers(&table, "").map_err(|msg| Error::scene(path, msg))?;
+    if set.is_empty() {
+        return toml::from_str(text).map_err(syntax_error);
+    }
+    let keys: Vec<&str> = set.iter().map(|(k, _)| k.as_str()).collect();
+    table.try_into().map_err(|e: toml::de::Error| {
+        Error::scene(path, format!("{} (with --set {})", e.message(), keys.join(", --set ")))
+    })
 }
 
 /// An error naming the first number under `value` (at key path `key`) that is not a finite
@@ -102,7 +116,7 @@ fn check_numbers(value: &toml::Value, key: &str) -> Result<(), String> {
 /// as data (`color` false), for `tessera bake`.
 pub fn load_texture(path: &Path, name: &str, color: bool) -> Result<Texture> {
     let text = read_scene_file(path)?;
-    let desc = parse_scene(&text, path)?;
+    let desc = parse_scene(&text, path, &[])?;
     let role = if color { Role::Color } else { Role::Data };
     Ok(Loader::new(path, &desc).build_texture(name, role, "--texture")?.0)
 }

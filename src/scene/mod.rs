@@ -5,6 +5,7 @@ pub mod desc;
 mod gltf;
 mod load;
 mod mitsuba;
+mod set;
 
 pub use load::{SceneOverrides, load_scene, load_scene_str, load_texture};
 pub use mitsuba::{MitsubaExport, export_mitsuba};
