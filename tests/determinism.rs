@@ -1,9 +1,12 @@
-//! The same scene and seed give a bit-identical EXR whatever the number of threads.
+//! The same scene and seed give a bit-identical EXR whatever the number of threads, and whatever
+//! passes the samples are rendered in.
 
 mod common;
 
+use std::sync::atomic::AtomicBool;
+use tessera::image::Aov;
 use tessera::image::write_image;
-use tessera::integrator::render;
+use tessera::integrator::{Crop, Ending, PassLimits, render, render_in_passes, render_samples};
 
 #[test]
 fn exr_is_bit_identical_with_one_and_two_threads() {
@@ -98,4 +101,30 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
     });
     let first = render(&scene, None, &[], &|_, _| {}).radiance();
     assert_ne!(other.unwrap().data, first.data, "a different seed should change the noise");
+
+    // Rendered in passes (--time-limit, --checkpoint, Ctrl-C), with AOVs and a crop: the same
+    // radiance, variance and AOVs, bit for bit, however 0..spp is split; a stopped pass leaves
+    // the film as it was.
+    let crop = Crop { x0: 3, y0: 2, x1: 21, y1: 17 };
+    let aovs = [Aov::Albedo, Aov::Uv];
+    let whole = render(&scene, Some(crop), &aovs, &|_, _| {});
+    let never = AtomicBool::new(false);
+    for splits in [&[0u32, 6][..], &[0, 1, 6], &[0, 2, 3, 5, 6], &[0, 1, 2, 3, 4, 5, 6]] {
+        let mut film = tessera::image::Film::new(18, 15, &aovs);
+        for range in splits.windows(2) {
+            film = render_samples(&scene, crop, &film, range[0]..range[1], &|_, _| {}, &never).unwrap();
+        }
+        assert_eq!(film.samples_per_pixel(), Some(6));
+        let same = |a: tessera::image::Bitmap, b: tessera::image::Bitmap| a.data == b.data;
+        assert!(same(film.radiance(), whole.radiance()) && same(film.variance(), whole.variance()), "{splits:?}");
+        assert!(aovs.iter().all(|a| same(film.aov(*a).unwrap(), whole.aov(*a).unwrap())), "{splits:?}");
+    }
+    let half = render_samples(&scene, crop, &tessera::image::Film::new(18, 15, &aovs), 0..3, &|_, _| {}, &never);
+    let stopped = render_samples(&scene, crop, &half.unwrap(), 3..6, &|_, _| {}, &AtomicBool::new(true));
+    assert!(stopped.is_none(), "a stopped pass gives no film");
+    // In passes under a time limit, whole samples per pixel, as many as fit.
+    let limits = PassLimits { time_limit: None, longest_pass: std::time::Duration::from_secs(30) };
+    let (film, spp, ending) = render_in_passes(&scene, crop, &aovs, limits, &never, &|_, _| {}, |_, _| Ok(())).unwrap();
+    assert_eq!((spp, ending), (6, Ending::Complete));
+    assert!(film.radiance().data == whole.radiance().data);
 }

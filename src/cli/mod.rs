@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 use tessera::error::{Error, Result};
 use tessera::image::{Aov, Bitmap, ColorSpace, OutputFormat, read_bitmap, write_image};
-use tessera::integrator::{Crop, render};
+use tessera::integrator::Crop;
 use tessera::limits;
 use tessera::scene::{Scene, SceneOverrides, load_scene};
 use tessera::texture::{BakeFootprint, bake};
@@ -62,6 +62,14 @@ enum Command {
         /// none is a string). Repeatable.
         #[arg(long = "set", value_name = "KEY=VALUE", value_parser = key_value)]
         set: Vec<(String, String)>,
+        /// Stop before the time runs out (seconds, from the start of rendering): as many whole
+        /// samples per pixel as fit, the image written with its real count.
+        #[arg(long, value_name = "SECONDS", value_parser = seconds)]
+        time_limit: Option<std::time::Duration>,
+        /// Write the image so far to the output every SECONDS (atomically), between passes.
+        /// Without it, Ctrl-C still writes the image of the passes done (exit status 130).
+        #[arg(long, value_name = "SECONDS", value_parser = seconds)]
+        checkpoint: Option<std::time::Duration>,
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
@@ -265,14 +273,27 @@ impl From<FootprintArg> for BakeFootprint {
 /// Parse the command line and run it.
 pub fn run() -> Result<ExitCode> {
     match Cli::parse().command {
-        Command::Render { scene, output, spp, threads, seed, crop, aov, variance, set, quiet } => {
+        Command::Render {
+            scene,
+            output,
+            spp,
+            threads,
+            seed,
+            crop,
+            aov,
+            variance,
+            set,
+            time_limit,
+            checkpoint,
+            quiet,
+        } => {
             let overrides = SceneOverrides { spp, seed, set, ..Default::default() };
             let output = output.unwrap_or_else(|| default_output(&scene));
             tessera::image::OutputFormat::from_path(&output)?;
             let scene = load(&scene, &overrides, quiet)?;
             let crop = crop.map(|c| parse_crop(&c, &scene)).transpose()?;
-            render_to_file(&scene, &output, threads, crop, &aov, variance, quiet)?;
-            Ok(ExitCode::SUCCESS)
+            let control = RenderControl { time_limit, checkpoint, variance, quiet };
+            render_to_file(&scene, &output, threads, crop, &aov, control)
         }
         Command::Info { scene } => {
             let scene = load(&scene, &SceneOverrides::default(), false)?;
@@ -432,6 +453,15 @@ fn load(path: &Path, overrides: &SceneOverrides, quiet: bool) -> Result<Scene> {
     Ok(scene)
 }
 
+/// A positive, finite number of seconds (`--time-limit`, `--checkpoint`).
+fn seconds(text: &str) -> std::result::Result<std::time::Duration, String> {
+    let s: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds"))?;
+    if !(s > 0.0 && s <= 1e9) {
+        return Err(format!("{s} seconds is not within (0, 1e9]"));
+    }
+    Ok(std::time::Duration::from_secs_f64(s))
+}
+
 /// `KEY=VALUE` of `--set`.
 fn key_value(text: &str) -> std::result::Result<(String, String), String> {
     let (key, value) = text.split_once('=').ok_or_else(|| format!("'{text}' is not KEY=VALUE"))?;
@@ -455,21 +485,39 @@ fn parse_crop(text: &str, scene: &Scene) -> Result<Crop> {
     Ok(Crop { x0, y0, x1, y1 })
 }
 
+/// How a render may end early, how often it writes what it has, and what it writes and prints.
+#[derive(Clone, Copy, Debug)]
+struct RenderControl {
+    /// `--time-limit`.
+    time_limit: Option<std::time::Duration>,
+    /// `--checkpoint`.
+    checkpoint: Option<std::time::Duration>,
+    /// `--variance`: the per-pixel variance in the EXR.
+    variance: bool,
+    /// `-q`.
+    quiet: bool,
+}
+
+/// Longest pass of a render without checkpoints: what Ctrl-C can lose.
+const LONGEST_PASS: std::time::Duration = std::time::Duration::from_secs(30);
+
 fn render_to_file(
     scene: &Scene,
     output: &Path,
     threads: Option<usize>,
     crop: Option<Crop>,
     aovs: &[Aov],
-    variance: bool,
-    quiet: bool,
-) -> Result<()> {
+    control: RenderControl,
+) -> Result<ExitCode> {
+    let (variance, quiet) = (control.variance, control.quiet);
+    use std::sync::atomic::{AtomicBool, Ordering};
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| Error::param("--threads", e.to_string()))?;
     let s = scene.settings;
-    let (w, h) = crop.map_or((s.width, s.height), |c| c.size());
+    let crop = crop.unwrap_or(Crop::full(s.width, s.height));
+    let (w, h) = crop.size();
     let total = w as u64 * h as u64 * s.spp as u64;
     let bar = if quiet { ProgressBar::hidden() } else { ProgressBar::new(total) };
     bar.set_style(
@@ -477,37 +525,83 @@ fn render_to_file(
             .expect("valid template"),
     );
     bar.set_message(format!("{w}x{h}, {} spp, {} threads", s.spp, pool.current_num_threads()));
+    // Ctrl-C ends the pass under way and writes the image of the passes done; a second one
+    // ends the process at once.
+    static STOP: AtomicBool = AtomicBool::new(false);
+    let _ = ctrlc::set_handler(|| {
+        if STOP.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    let limits = tessera::integrator::PassLimits {
+        time_limit: control.time_limit,
+        longest_pass: control.checkpoint.unwrap_or(LONGEST_PASS).min(LONGEST_PASS),
+    };
     let start = Instant::now();
-    let film = pool.install(|| render(scene, crop, aovs, &|done, _| bar.set_position(done)));
+    let mut last_checkpoint = Instant::now();
+    let (film, spp, ending) = pool.install(|| {
+        tessera::integrator::render_in_passes(
+            scene,
+            crop,
+            aovs,
+            limits,
+            &STOP,
+            &|done, _| bar.set_position(done),
+            |film, spp| {
+                if control.checkpoint.is_some_and(|every| last_checkpoint.elapsed() >= every) && spp < s.spp {
+                    write_film(output, film, scene, crop, variance)?;
+                    last_checkpoint = Instant::now();
+                    bar.set_message(format!("{w}x{h}, checkpoint of {spp} of {} spp written", s.spp));
+                }
+                Ok(())
+            },
+        )
+    })?;
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    use tessera::integrator::Ending;
+    if spp == 0 {
+        let why = if ending == Ending::Stopped { "interrupted" } else { "the time limit came" };
+        return Err(Error::param("render", format!("{why} before one sample per pixel was done: nothing written")));
+    }
+    write_film(output, &film, scene, crop, variance)?;
+    if !quiet {
+        let invalid = film.invalid_sample_count();
+        if invalid > 0 {
+            eprintln!("warning: {invalid} samples had non-finite radiance and were counted as black");
+        }
+        match ending {
+            Ending::Complete => {}
+            Ending::TimeLimit => eprintln!("time limit: {spp} of {} spp rendered", s.spp),
+            Ending::Stopped => eprintln!("interrupted: {spp} of {} spp rendered", s.spp),
+        }
+        eprintln!(
+            "{}: {w}x{h}, {spp} spp in {seconds:.2} s ({:.2} M samples/s) -> {}",
+            scene.path.display(),
+            film.sample_count() as f64 / seconds / 1e6,
+            output.display()
+        );
+    }
+    Ok(if ending == Ending::Stopped { ExitCode::from(130) } else { ExitCode::SUCCESS })
+}
 
+/// Write a render's film (radiance, its AOVs and optionally the variance) to `output`,
+/// atomically; a crop's EXR keeps its place in the frame (the data window), for `tessera merge`.
+fn write_film(output: &Path, film: &tessera::image::Film, scene: &Scene, crop: Crop, variance: bool) -> Result<()> {
     let mut extra: Vec<(&[&str], tessera::image::Bitmap)> =
-        aovs.iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();
+        film.aovs().iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();
     if variance {
         extra.push((&["variance.R", "variance.G", "variance.B"], film.variance()));
     }
     if !extra.is_empty() && tessera::image::OutputFormat::from_path(output)? == tessera::image::OutputFormat::Png {
         eprintln!("warning: AOVs are written to EXR outputs only");
     }
-    // A crop's EXR keeps its place in the frame (the data window), for `tessera merge`.
-    let origin = crop.map_or((0, 0), |c| (c.x0 as usize, c.y0 as usize));
-    let window = tessera::image::ExrWindow { origin, full: (s.width as usize, s.height as usize) };
-    tessera::image::write_image_in(output, &film.radiance(), &extra, window)?;
-    if !quiet {
-        let invalid = film.invalid_sample_count();
-        if invalid > 0 {
-            eprintln!("warning: {invalid} samples had non-finite radiance and were counted as black");
-        }
-        eprintln!(
-            "{}: {w}x{h}, {} spp in {seconds:.2} s ({:.2} M samples/s) -> {}",
-            scene.path.display(),
-            s.spp,
-            film.sample_count() as f64 / seconds / 1e6,
-            output.display()
-        );
-    }
-    Ok(())
+    let s = scene.settings;
+    let window = tessera::image::ExrWindow {
+        origin: (crop.x0 as usize, crop.y0 as usize),
+        full: (s.width as usize, s.height as usize),
+    };
+    tessera::image::write_image_in(output, &film.radiance(), &extra, window)
 }
 
 fn diff(

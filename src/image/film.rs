@@ -112,6 +112,17 @@ impl Film {
         self.pixels[y * self.width + x] = sum;
     }
 
+    /// The accumulated samples of pixel (x, y).
+    pub fn pixel(&self, x: usize, y: usize) -> &PixelSum {
+        &self.pixels[y * self.width + x]
+    }
+
+    /// Samples per pixel, where every pixel has the same number (None otherwise, or empty).
+    pub fn samples_per_pixel(&self) -> Option<u32> {
+        let first = self.pixels.first()?.count;
+        self.pixels.iter().all(|p| p.count == first).then_some(first)
+    }
+
     /// Total number of samples taken.
     pub fn sample_count(&self) -> u64 {
         self.pixels.iter().map(|p| p.count as u64).sum()

@@ -3,17 +3,19 @@
 
 mod path;
 pub mod primary;
+mod progressive;
 
 pub use path::{FirstHit, PathTracer};
+pub use progressive::{Ending, PassLimits, render_in_passes};
 
 use crate::color::Rgb;
-use crate::image::{Aov, Film, PixelSum};
+use crate::image::{Aov, Film};
 use crate::sampling::PixelKey;
 use crate::scene::Scene;
 use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Side of the square tiles work is split into.
 const TILE: u32 = 16;
@@ -68,17 +70,42 @@ fn aov_values(aovs: &[Aov], hit: &Option<path::FirstHit>, out: &mut [f32]) {
 /// `aovs`. `progress(done, total)` is called as samples complete (from worker threads).
 /// Runs on the current rayon thread pool.
 pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn Fn(u64, u64) + Sync)) -> Film {
-    let s = scene.settings;
-    let crop = crop.unwrap_or(Crop::full(s.width, s.height));
+    let crop = crop.unwrap_or(Crop::full(scene.settings.width, scene.settings.height));
     let (w, h) = crop.size();
-    let film = Mutex::new(Film::new(w as usize, h as usize, aovs));
-    let stride = film.lock().expect("fresh").aov_stride();
+    let empty = Film::new(w as usize, h as usize, aovs);
+    render_samples(scene, crop, &empty, 0..scene.settings.spp, progress, &AtomicBool::new(false))
+        .expect("never stopped")
+}
+
+/// Continue `film` (the pixels of `crop`, each holding its samples 0..`samples.start`) with the
+/// samples `samples` of every pixel, returning the film that holds 0..`samples.end`. Each
+/// pixel's samples are added to its running sums in order, so any split of 0..spp into ranges
+/// gives the image of one uninterrupted render bit for bit (progressive output, time limits,
+/// resuming). None if `stop` is set before the last tile is done (the pass is then lost, not
+/// half kept: `film` is left as it was).
+pub fn render_samples(
+    scene: &Scene,
+    crop: Crop,
+    film: &Film,
+    samples: std::ops::Range<u32>,
+    progress: &(dyn Fn(u64, u64) + Sync),
+    stop: &AtomicBool,
+) -> Option<Film> {
+    let s = scene.settings;
+    let (w, h) = crop.size();
+    let stride = film.aov_stride();
+    let aovs = film.aovs();
+    let next = Mutex::new(film.clone());
     let tracer = PathTracer::new(scene, !aovs.is_empty(), aovs.contains(&Aov::Footprint));
-    let total = w as u64 * h as u64 * s.spp as u64;
+    let spp = samples.len() as u64;
+    let total = w as u64 * h as u64 * spp;
     let done = AtomicU64::new(0);
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty))).collect();
     tiles.par_iter().for_each(|&(tx, ty)| {
+        if stop.load(Ordering::Relaxed) {
+            return;
+        }
         let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
         let mut aov_buf = vec![0.0f32; stride];
         let mut primary = [None; PACKET];
@@ -86,7 +113,7 @@ pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn F
             for fx in tx * TILE..((tx + 1) * TILE).min(w) {
                 let (px, py) = (crop.x0 + fx, crop.y0 + fy);
                 let pixel_index = py as u64 * s.width as u64 + px as u64;
-                let mut sum = PixelSum::new(stride);
+                let mut sum = film.pixel(fx as usize, fy as usize).clone();
                 let key = PixelKey::new(s.seed, pixel_index);
                 let camera_sample = |i: u32| {
                     let mut sampler = key.sampler(i);
@@ -96,8 +123,8 @@ pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn F
                 };
                 // The camera rays of up to PACKET samples at a time are traced together, as a
                 // packet (`Accel::intersect_many`); then each sample's path on its own.
-                for first in (0..s.spp).step_by(PACKET) {
-                    let count = (s.spp - first).min(PACKET as u32) as usize;
+                for first in samples.clone().step_by(PACKET) {
+                    let count = (samples.end - first).min(PACKET as u32) as usize;
                     // Slots past `count` repeat the last sample, and are not traced.
                     let batch: [_; PACKET] = std::array::from_fn(|k| camera_sample(first + k.min(count - 1) as u32));
                     let rays = batch.each_ref().map(|b| b.0);
@@ -112,14 +139,15 @@ pub fn render(scene: &Scene, crop: Option<Crop>, aovs: &[Aov], progress: &(dyn F
                 pixels.push((fx as usize, fy as usize, sum));
             }
         }
-        let samples = pixels.len() as u64 * s.spp as u64;
+        let taken = pixels.len() as u64 * spp;
         {
-            let mut film = film.lock().expect("no panics while holding the film");
+            let mut next = next.lock().expect("no panics while holding the film");
             for (x, y, sum) in pixels {
-                film.set_pixel(x, y, sum);
+                next.set_pixel(x, y, sum);
             }
         }
-        progress(done.fetch_add(samples, Ordering::Relaxed) + samples, total);
+        progress(done.fetch_add(taken, Ordering::Relaxed) + taken, total);
     });
-    film.into_inner().expect("no panics while holding the film")
+    let complete = done.load(Ordering::Relaxed) == total;
+    complete.then(|| next.into_inner().expect("no panics while holding the film"))
 }

@@ -1,0 +1,83 @@
+//! A render in passes (`tessera render --time-limit / --checkpoint`, Ctrl-C): samples 0..spp of
+//! every pixel split into consecutive ranges, each rendered by [`render_samples`] onto the
+//! previous pass's film, so that the image after any pass is the image of that many samples per
+//! pixel, bit for bit, and the final one that of an uninterrupted render. Passes double in
+//! length from one sample per pixel, bounded by the time left and a longest pass, so that a
+//! time limit is kept and an interruption loses little.
+
+use super::{Crop, render_samples};
+use crate::image::{Aov, Film};
+use crate::scene::Scene;
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+/// When to stop early and how long a pass may take.
+#[derive(Clone, Copy, Debug)]
+pub struct PassLimits {
+    /// Stop before a pass that would end after this long (None: render every sample).
+    pub time_limit: Option<Duration>,
+    /// Longest pass, estimated from the passes so far (checkpoints are written between passes).
+    pub longest_pass: Duration,
+}
+
+/// Why a render in passes ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ending {
+    /// Every sample of the scene was rendered.
+    Complete,
+    /// The time limit left no room for another pass.
+    TimeLimit,
+    /// `stop` was set: the pass under way was dropped.
+    Stopped,
+}
+
+/// Render `crop` of `scene` in passes; `after_pass(film, spp)` sees the film after each pass
+/// (for checkpoints) and may fail the render; `progress(done, total)` counts samples over the
+/// whole render. Returns the film of the last whole pass, its samples per pixel, and why it
+/// ended.
+pub fn render_in_passes(
+    scene: &Scene,
+    crop: Crop,
+    aovs: &[Aov],
+    limits: PassLimits,
+    stop: &AtomicBool,
+    progress: &(dyn Fn(u64, u64) + Sync),
+    mut after_pass: impl FnMut(&Film, u32) -> crate::Result<()>,
+) -> crate::Result<(Film, u32, Ending)> {
+    let spp = scene.settings.spp;
+    let (w, h) = crop.size();
+    let per_pass_sample = w as u64 * h as u64;
+    let total = per_pass_sample * spp as u64;
+    let start = Instant::now();
+    let mut film = Film::new(w as usize, h as usize, aovs);
+    let (mut done, mut pass) = (0u32, 1u32);
+    while done < spp {
+        if let Some(limit) = limits.time_limit {
+            // Keep within the limit: no more samples than the time left allows at the rate so far.
+            let elapsed = start.elapsed();
+            if done > 0 {
+                let per_spp = elapsed.as_secs_f64() / done as f64;
+                let room = ((limit.saturating_sub(elapsed)).as_secs_f64() / per_spp).floor();
+                if room < 1.0 {
+                    return Ok((film, done, Ending::TimeLimit));
+                }
+                pass = pass.min(room as u32);
+            } else if elapsed >= limit {
+                return Ok((film, 0, Ending::TimeLimit));
+            }
+        }
+        if done > 0 {
+            let per_spp = start.elapsed().as_secs_f64() / done as f64;
+            pass = pass.min(((limits.longest_pass.as_secs_f64() / per_spp).floor() as u32).max(1));
+        }
+        let range = done..(done + pass).min(spp);
+        let base = per_pass_sample * done as u64;
+        let next = render_samples(scene, crop, &film, range.clone(), &|d, _| progress(base + d, total), stop);
+        let Some(next) = next else { return Ok((film, done, Ending::Stopped)) };
+        film = next;
+        done = range.end;
+        after_pass(&film, done)?;
+        pass = pass.saturating_mul(2);
+    }
+    Ok((film, done, Ending::Complete))
+}

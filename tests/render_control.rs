@@ -1,0 +1,110 @@
+//! Control of a render from the command line: `--set KEY=VALUE` (src/scene/set.rs) renders as
+//! the file would say it, bit for bit, and bad keys are errors that name the key, with nothing
+//! rendered; `--time-limit` writes the whole samples per pixel that fit; Ctrl-C writes the image
+//! of the passes done and exits 130 (src/integrator/progressive.rs; that passes add up to the
+//! uninterrupted image bit for bit is tests/determinism.rs).
+
+mod common;
+
+use std::process::Command;
+
+const SCENE: &str = "[render]\nwidth = 24\nheight = 18\nspp = 4\nseed = 7\n\
+     [camera]\nfov = 40\neye = [0, 1, 4]\ntarget = [0, 0, 0]\n\
+     [environment]\ntype = \"constant\"\nradiance = 0.5\n\
+     [materials.m]\ntype = \"diffuse\"\nreflectance = [0.7, 0.4, 0.2]\n\
+     [[shapes]]\ntype = \"uv_sphere\"\nmaterial = \"m\"\n";
+
+#[test]
+fn set_values_render_as_the_file_would_say_them() {
+    let dir = common::scene_dir(SCENE, &[]);
+    let edited = SCENE
+        .replace("width = 24", "width = 16")
+        .replace("fov = 40", "fov = 55.5")
+        .replace("reflectance = [0.7, 0.4, 0.2]", "reflectance = [0.1, 0.9, 0.3]");
+    std::fs::write(dir.path().join("edited.toml"), edited).unwrap();
+    let render = |scene: &str, out: &str, set: &[&str]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_tessera"));
+        cmd.arg("render").arg(dir.path().join(scene)).args(["-q", "-o"]).arg(dir.path().join(out));
+        set.iter().for_each(|s| {
+            cmd.args(["--set", s]);
+        });
+        let run = cmd.output().unwrap();
+        (run.status.code(), String::from_utf8_lossy(&run.stderr).into_owned(), dir.path().join(out))
+    };
+    let (code, err, by_set) = render(
+        "scene.toml",
+        "set.exr",
+        &["render.width=16", "camera.fov = 55.5", "materials.m.reflectance=[0.1, 0.9, 0.3]"],
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let (code, err, by_file) = render("edited.toml", "file.exr", &[]);
+    assert_eq!(code, Some(0), "{err}");
+    let (a, b) = (std::fs::read(&by_set).unwrap(), std::fs::read(&by_file).unwrap());
+    assert_eq!(a, b, "the same scene, set or written, renders the same bytes");
+    let image = tessera::image::read_exr_image(&by_set).unwrap();
+    assert_eq!((image.width, image.height), (16, 18));
+    for (set, needle) in [
+        ("render.widht=3", "unknown field `widht`"),
+        ("shapes[4].type=\"obj\"", "--set shapes[4].type"),
+        ("camera.fov=inf", "camera.fov"),
+    ] {
+        let (code, err, out) = render("scene.toml", "bad.exr", &[set]);
+        assert_eq!(code, Some(1), "{set}");
+        assert!(err.contains(needle), "{set}: {err}");
+        assert!(!out.exists(), "{set}");
+    }
+}
+
+/// The scene with a budget that no test waits for.
+fn endless() -> tempfile::TempDir {
+    common::scene_dir(&SCENE.replace("spp = 4", "spp = 1000000"), &[])
+}
+
+#[test]
+fn a_time_limit_writes_the_samples_that_fit() {
+    let dir = endless();
+    let out = dir.path().join("limited.exr");
+    let run = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("render")
+        .arg(dir.path().join("scene.toml"))
+        .args(["--time-limit", "0.5", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    assert!(stderr.contains("time limit: ") && stderr.contains(" of 1000000 spp rendered"), "{stderr}");
+    assert!(tessera::image::read_exr_image(&out).is_ok());
+    for bad in ["0", "-1", "nan", "soon"] {
+        let run = Command::new(env!("CARGO_BIN_EXE_tessera"))
+            .arg("render")
+            .arg(dir.path().join("scene.toml"))
+            .args(["--time-limit", bad])
+            .output()
+            .unwrap();
+        assert_eq!(run.status.code(), Some(2), "--time-limit {bad}");
+    }
+}
+
+#[test]
+fn ctrl_c_writes_the_image_so_far_and_exits_130() {
+    let dir = endless();
+    let out = dir.path().join("interrupted.exr");
+    let child = Command::new(env!("CARGO_BIN_EXE_tessera"))
+        .arg("render")
+        .arg(dir.path().join("scene.toml"))
+        .arg("-o")
+        .arg(&out)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(kill.success());
+    let run = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted: ") && stderr.contains(" of 1000000 spp rendered"), "{stderr}");
+    let image = tessera::image::read_exr_image(&out).unwrap();
+    assert_eq!((image.width, image.height), (24, 18));
+}
