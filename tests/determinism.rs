@@ -124,7 +124,8 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
     assert!(stopped.is_none(), "a stopped pass gives no film");
     // In passes under a time limit, whole samples per pixel, as many as fit.
     let limits = PassLimits { time_limit: None, longest_pass: std::time::Duration::from_secs(30) };
-    let (film, spp, ending) = render_in_passes(&scene, crop, &aovs, limits, &never, &|_, _| {}, |_, _| Ok(())).unwrap();
+    let empty = tessera::image::Film::new(18, 15, &aovs);
+    let (film, spp, ending) = render_in_passes(&scene, crop, empty, limits, &never, &|_, _| {}, |_, _| Ok(())).unwrap();
     assert_eq!((spp, ending), (6, Ending::Complete));
     assert!(film.radiance().data == whole.radiance().data);
 }

@@ -250,3 +250,57 @@ fn normal_mapped_mirror_under_uniform_sky_matches_its_model() {
     });
     assert_mean(toml, &[("n.png", &png)], expected, 2e-3, "normal-mapped mirror");
 }
+
+/// A plane z = -3 seen head-on from the origin: the depth AOV of the ray through film point
+/// (x, y) on the image plane at distance 1 (tan of half the field of view t) is
+/// 3 sqrt(1 + x^2 + y^2) and its position (3x, 3y, -3); a pixel's AOVs average its samples, so
+/// the expected values are averaged over the same jittered film points.
+#[test]
+fn depth_and_position_aovs_are_the_first_hit_s() {
+    use tessera::image::Aov;
+    let toml = r#"
+        [render]
+        width = 8
+        height = 8
+        spp = 16
+        [camera]
+        fov = 60
+        eye = [0, 0, 0]
+        target = [0, 0, -1]
+        [environment]
+        type = "constant"
+        radiance = 1
+        [materials.m]
+        type = "diffuse"
+        reflectance = 0.5
+        [[shapes]]
+        type = "rectangle"
+        material = "m"
+        transform = [{ scale = 20 }, { translate = [0, 0, -3] }]
+    "#;
+    let (_dir, scene) = scene(toml, &[]);
+    let film = tessera::integrator::render(&scene, None, &[Aov::Depth, Aov::Position], &|_, _| {});
+    let (depth, position) = (film.aov(Aov::Depth).unwrap(), film.aov(Aov::Position).unwrap());
+    let t = (30.0f32).to_radians().tan();
+    for (x, y) in [(0usize, 0usize), (3, 4), (7, 2)] {
+        let p = position.pixel(x, y);
+        // Every sample hits z = -3, and depth = |p| exactly for each; the pixel means keep
+        // z = -3 and bound the depth between the nearest and farthest corner of the pixel.
+        assert!((p.z + 3.0).abs() < 1e-5, "({x}, {y}): {p}");
+        let corner = |i: f32, j: f32| {
+            let (fx, fy) = ((2.0 * i / 8.0 - 1.0) * t, (1.0 - 2.0 * j / 8.0) * t);
+            3.0 * (1.0 + fx * fx + fy * fy).sqrt()
+        };
+        let corners = [
+            corner(x as f32, y as f32),
+            corner(x as f32 + 1.0, y as f32),
+            corner(x as f32, y as f32 + 1.0),
+            corner(x as f32 + 1.0, y as f32 + 1.0),
+        ];
+        let (lo, hi) = corners.iter().fold((f32::MAX, 0.0f32), |(l, h), c| (l.min(*c), h.max(*c)));
+        let d = depth.pixel(x, y).x;
+        assert!(d >= lo - 1e-4 && d <= hi + 1e-4, "({x}, {y}): depth {d} outside [{lo}, {hi}]");
+        // And the mean position's distance is within the same bounds.
+        assert!(p.truncate().length() <= hi + 1e-4 && p.truncate().length() >= 3.0, "({x}, {y}): {p}");
+    }
+}

@@ -108,3 +108,38 @@ fn ctrl_c_writes_the_image_so_far_and_exits_130() {
     let image = tessera::image::read_exr_image(&out).unwrap();
     assert_eq!((image.width, image.height), (24, 18));
 }
+
+#[test]
+fn a_resumed_render_equals_an_uninterrupted_one_bit_for_bit() {
+    let dir = endless();
+    let scene = dir.path().join("scene.toml");
+    let run = |args: &[&str]| {
+        let run = Command::new(env!("CARGO_BIN_EXE_tessera")).arg("render").arg(&scene).args(args).output().unwrap();
+        (run.status.code(), String::from_utf8_lossy(&run.stderr).into_owned())
+    };
+    let (out, state) = (dir.path().join("r.exr"), dir.path().join("r.exr.state"));
+    let out_arg = out.to_str().unwrap();
+    let (code, err) = run(&["--time-limit", "0.3", "--aov", "albedo", "-o", out_arg]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(state.exists(), "an unfinished render leaves its state");
+    let done: u32 = err.split("time limit: ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    // Resumed to a few more samples than were done, against the same count rendered at once.
+    let spp = (done + 5).to_string();
+    for (args, needle) in [
+        (vec!["--resume", "--spp", &spp, "--aov", "albedo", "--seed", "9", "-o", out_arg], "another scene"),
+        (vec!["--resume", "--spp", &spp, "-o", out_arg], "another crop, resolution or AOVs"),
+        (vec!["--resume", "--spp", &spp, "--aov", "albedo", "-o", "elsewhere.exr"], "no unfinished render"),
+    ] {
+        let (code, err) = run(&args);
+        assert_eq!(code, Some(1), "{args:?}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+    }
+    let (code, err) = run(&["--resume", "--spp", &spp, "--aov", "albedo", "-o", out_arg]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains(&format!("resuming {out_arg} from {done} of {spp} spp")), "{err}");
+    assert!(!state.exists(), "a finished render removes its state");
+    let whole = dir.path().join("whole.exr");
+    let (code, err) = run(&["--spp", &spp, "--aov", "albedo", "-q", "-o", whole.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&whole).unwrap());
+}

@@ -66,10 +66,16 @@ enum Command {
         /// samples per pixel as fit, the image written with its real count.
         #[arg(long, value_name = "SECONDS", value_parser = seconds)]
         time_limit: Option<std::time::Duration>,
-        /// Write the image so far to the output every SECONDS (atomically), between passes.
-        /// Without it, Ctrl-C still writes the image of the passes done (exit status 130).
+        /// Write the image so far to the output every SECONDS (atomically), between passes,
+        /// with its state (OUTPUT.state) for --resume. Without it, Ctrl-C and --time-limit
+        /// still write the image and the state of the passes done (Ctrl-C: exit status 130).
         #[arg(long, value_name = "SECONDS", value_parser = seconds)]
         checkpoint: Option<std::time::Duration>,
+        /// Continue the unfinished render whose state is OUTPUT.state (same scene, --set
+        /// values, crop and AOVs; the sample count may grow): the image equals an uninterrupted
+        /// render's bit for bit.
+        #[arg(long)]
+        resume: bool,
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
@@ -285,14 +291,21 @@ pub fn run() -> Result<ExitCode> {
             set,
             time_limit,
             checkpoint,
+            resume,
             quiet,
         } => {
-            let overrides = SceneOverrides { spp, seed, set, ..Default::default() };
+            let overrides = SceneOverrides { spp, seed, set: set.clone(), ..Default::default() };
             let output = output.unwrap_or_else(|| default_output(&scene));
             tessera::image::OutputFormat::from_path(&output)?;
+            let text = tessera::files::read_bounded(&scene, limits::MAX_SCENE_FILE_BYTES, "a scene file")?;
             let scene = load(&scene, &overrides, quiet)?;
             let crop = crop.map(|c| parse_crop(&c, &scene)).transpose()?;
-            let control = RenderControl { time_limit, checkpoint, variance, quiet };
+            // The state of an unfinished render belongs to this scene text, these values set and
+            // these settings, whatever the sample count.
+            let settings = tessera::scene::RenderSettings { spp: 0, ..scene.settings };
+            let made_from = [text, format!("{set:?}{settings:?}").into_bytes()].concat();
+            let fingerprint = tessera::integrator::fingerprint(&made_from);
+            let control = RenderControl { time_limit, checkpoint, variance, quiet, resume, fingerprint };
             render_to_file(&scene, &output, threads, crop, &aov, control)
         }
         Command::Info { scene } => {
@@ -496,6 +509,17 @@ struct RenderControl {
     variance: bool,
     /// `-q`.
     quiet: bool,
+    /// `--resume`: continue from the output's state file.
+    resume: bool,
+    /// What the render is made from, for its state file ([`tessera::integrator::Checkpoint`]).
+    fingerprint: u64,
+}
+
+/// The state file of an unfinished render beside its output: `OUTPUT.state`.
+fn state_path(output: &Path) -> PathBuf {
+    let mut name = output.file_name().map(|n| n.to_os_string()).unwrap_or_default();
+    name.push(".state");
+    output.with_file_name(name)
 }
 
 /// Longest pass of a render without checkpoints: what Ctrl-C can lose.
@@ -537,19 +561,39 @@ fn render_to_file(
         time_limit: control.time_limit,
         longest_pass: control.checkpoint.unwrap_or(LONGEST_PASS).min(LONGEST_PASS),
     };
+    let state = state_path(output);
+    let checkpoint = |film: &tessera::image::Film, samples: u32| {
+        let film = film.clone();
+        tessera::integrator::Checkpoint { fingerprint: control.fingerprint, crop, samples, film }.write(&state)
+    };
+    let start_film = if control.resume {
+        if !state.exists() {
+            let msg = format!("no unfinished render to resume: {} does not exist", state.display());
+            return Err(Error::param("--resume", msg));
+        }
+        let resumed = tessera::integrator::Checkpoint::read(&state, control.fingerprint, crop, aovs)?;
+        if !quiet {
+            eprintln!("resuming {} from {} of {} spp", output.display(), resumed.samples, s.spp);
+        }
+        resumed.film
+    } else {
+        tessera::image::Film::new(w as usize, h as usize, aovs)
+    };
+    bar.set_length(w as u64 * h as u64 * s.spp.saturating_sub(start_film.samples_per_pixel().unwrap_or(0)) as u64);
     let start = Instant::now();
     let mut last_checkpoint = Instant::now();
     let (film, spp, ending) = pool.install(|| {
         tessera::integrator::render_in_passes(
             scene,
             crop,
-            aovs,
+            start_film,
             limits,
             &STOP,
             &|done, _| bar.set_position(done),
             |film, spp| {
                 if control.checkpoint.is_some_and(|every| last_checkpoint.elapsed() >= every) && spp < s.spp {
                     write_film(output, film, scene, crop, variance)?;
+                    checkpoint(film, spp)?;
                     last_checkpoint = Instant::now();
                     bar.set_message(format!("{w}x{h}, checkpoint of {spp} of {} spp written", s.spp));
                 }
@@ -565,6 +609,14 @@ fn render_to_file(
         return Err(Error::param("render", format!("{why} before one sample per pixel was done: nothing written")));
     }
     write_film(output, &film, scene, crop, variance)?;
+    // An unfinished render leaves its state for --resume; a finished one removes it.
+    if ending == Ending::Complete {
+        if state.exists() {
+            std::fs::remove_file(&state).map_err(|e| Error::io(&state, e))?;
+        }
+    } else {
+        checkpoint(&film, spp)?;
+    }
     if !quiet {
         let invalid = film.invalid_sample_count();
         if invalid > 0 {

@@ -17,15 +17,19 @@ pub enum Aov {
     Uv,
     /// Texture footprint: max(|duv/dx|, |duv/dy|) in uv units.
     Footprint,
+    /// World position of the hit (x, y, z).
+    Position,
+    /// Distance from the camera to the hit along the camera ray (Mitsuba's `depth` AOV).
+    Depth,
 }
 
 impl Aov {
     /// Number of channels of this AOV.
     pub fn channels(self) -> usize {
         match self {
-            Aov::Albedo | Aov::Normal => 3,
+            Aov::Albedo | Aov::Normal | Aov::Position => 3,
             Aov::Uv => 2,
-            Aov::Footprint => 1,
+            Aov::Footprint | Aov::Depth => 1,
         }
     }
 
@@ -36,6 +40,8 @@ impl Aov {
             Aov::Normal => &["normal.X", "normal.Y", "normal.Z"],
             Aov::Uv => &["uv.U", "uv.V"],
             Aov::Footprint => &["footprint.Y"],
+            Aov::Position => &["position.X", "position.Y", "position.Z"],
+            Aov::Depth => &["depth.Z"],
         }
     }
 }
@@ -121,6 +127,44 @@ impl Film {
     pub fn samples_per_pixel(&self) -> Option<u32> {
         let first = self.pixels.first()?.count;
         self.pixels.iter().all(|p| p.count == first).then_some(first)
+    }
+
+    /// The running sums of every pixel as bytes, for a render to be resumed ([`Film::from_state`]):
+    /// per pixel, little-endian, sum and sum of squares of R, G, B (f64), the sample and invalid
+    /// counts (u32), then the AOV sums (f64).
+    pub fn state(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.pixels.len() * self.state_bytes_per_pixel());
+        for p in &self.pixels {
+            p.sum.iter().chain(&p.sum_sq).for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+            out.extend_from_slice(&p.count.to_le_bytes());
+            out.extend_from_slice(&p.invalid.to_le_bytes());
+            p.aov.iter().for_each(|v| out.extend_from_slice(&v.to_le_bytes()));
+        }
+        out
+    }
+
+    /// A `width` x `height` film recording `aovs` from [`Film::state`] bytes; None unless
+    /// `bytes` is exactly such a film's state.
+    pub fn from_state(width: usize, height: usize, aovs: &[Aov], bytes: &[u8]) -> Option<Film> {
+        let mut film = Film::new(width, height, aovs);
+        let per_pixel = film.state_bytes_per_pixel();
+        if bytes.len() != per_pixel.checked_mul(width.checked_mul(height)?)? {
+            return None;
+        }
+        let f64_at = |b: &[u8], k: usize| f64::from_le_bytes(b[8 * k..8 * k + 8].try_into().expect("8 bytes"));
+        for (p, b) in film.pixels.iter_mut().zip(bytes.chunks_exact(per_pixel)) {
+            p.sum = std::array::from_fn(|c| f64_at(b, c));
+            p.sum_sq = std::array::from_fn(|c| f64_at(b, 3 + c));
+            p.count = u32::from_le_bytes(b[48..52].try_into().expect("4 bytes"));
+            p.invalid = u32::from_le_bytes(b[52..56].try_into().expect("4 bytes"));
+            p.aov.iter_mut().enumerate().for_each(|(k, v)| *v = f64_at(&b[56..], k));
+        }
+        Some(film)
+    }
+
+    /// Bytes per pixel of [`Film::state`].
+    fn state_bytes_per_pixel(&self) -> usize {
+        6 * 8 + 2 * 4 + 8 * self.aov_stride
     }
 
     /// Total number of samples taken.

@@ -1,10 +1,12 @@
 //! Rendering an image: tiles in parallel (rayon), each pixel's samples in a fixed order, so the
 //! image is bit-identical whatever the number of threads.
 
+mod checkpoint;
 mod path;
 pub mod primary;
 mod progressive;
 
+pub use checkpoint::{Checkpoint, fingerprint};
 pub use path::{FirstHit, PathTracer};
 pub use progressive::{Ending, PassLimits, render_in_passes};
 
@@ -60,6 +62,8 @@ fn aov_values(aovs: &[Aov], hit: &Option<path::FirstHit>, out: &mut [f32]) {
             Aov::Normal => &h.normal.to_array(),
             Aov::Uv => &h.uv.to_array(),
             Aov::Footprint => &[h.footprint],
+            Aov::Position => &h.position.to_array(),
+            Aov::Depth => &[h.depth],
         };
         out[i..i + values.len()].copy_from_slice(values);
         i += values.len();

@@ -24,6 +24,10 @@ pub struct FirstHit {
     pub uv: Vec2,
     /// max(|duv/dx|, |duv/dy|).
     pub footprint: f32,
+    /// World position.
+    pub position: Vec3,
+    /// Distance from the camera ray's origin.
+    pub depth: f32,
 }
 
 /// Largest continuation probability of Russian roulette (Mitsuba's).
@@ -141,6 +145,8 @@ impl<'a> PathTracer<'a> {
                     normal: frame.n,
                     uv: si.uv,
                     footprint: si.duv_dx.abs().max(si.duv_dy.abs()).max_element(),
+                    position: si.p,
+                    depth: si.p.distance(ray.o),
                 });
             }
 

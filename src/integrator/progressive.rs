@@ -6,7 +6,7 @@
 //! time limit is kept and an interruption loses little.
 
 use super::{Crop, render_samples};
-use crate::image::{Aov, Film};
+use crate::image::Film;
 use crate::scene::Scene;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
@@ -31,14 +31,15 @@ pub enum Ending {
     Stopped,
 }
 
-/// Render `crop` of `scene` in passes; `after_pass(film, spp)` sees the film after each pass
-/// (for checkpoints) and may fail the render; `progress(done, total)` counts samples over the
-/// whole render. Returns the film of the last whole pass, its samples per pixel, and why it
-/// ended.
+/// Render `crop` of `scene` in passes, continuing `start` (a film of the crop holding whole
+/// samples per pixel: empty, or a [`super::Checkpoint`]'s); `after_pass(film, spp)` sees the
+/// film after each pass (for checkpoints) and may fail the render; `progress(done, total)`
+/// counts samples over the whole render. Returns the film of the last whole pass, its samples
+/// per pixel, and why it ended.
 pub fn render_in_passes(
     scene: &Scene,
     crop: Crop,
-    aovs: &[Aov],
+    start_film: Film,
     limits: PassLimits,
     stop: &AtomicBool,
     progress: &(dyn Fn(u64, u64) + Sync),
@@ -46,32 +47,34 @@ pub fn render_in_passes(
 ) -> crate::Result<(Film, u32, Ending)> {
     let spp = scene.settings.spp;
     let (w, h) = crop.size();
+    debug_assert_eq!(start_film.resolution(), (w as usize, h as usize));
     let per_pass_sample = w as u64 * h as u64;
-    let total = per_pass_sample * spp as u64;
+    let total = per_pass_sample * spp.saturating_sub(start_film.samples_per_pixel().unwrap_or(0)) as u64;
     let start = Instant::now();
-    let mut film = Film::new(w as usize, h as usize, aovs);
-    let (mut done, mut pass) = (0u32, 1u32);
+    let resumed = start_film.samples_per_pixel().unwrap_or(0);
+    let mut film = start_film;
+    let (mut done, mut pass) = (resumed, 1u32);
     while done < spp {
         if let Some(limit) = limits.time_limit {
             // Keep within the limit: no more samples than the time left allows at the rate so far.
             let elapsed = start.elapsed();
-            if done > 0 {
-                let per_spp = elapsed.as_secs_f64() / done as f64;
+            if done > resumed {
+                let per_spp = elapsed.as_secs_f64() / (done - resumed) as f64;
                 let room = ((limit.saturating_sub(elapsed)).as_secs_f64() / per_spp).floor();
                 if room < 1.0 {
                     return Ok((film, done, Ending::TimeLimit));
                 }
                 pass = pass.min(room as u32);
             } else if elapsed >= limit {
-                return Ok((film, 0, Ending::TimeLimit));
+                return Ok((film, done, Ending::TimeLimit));
             }
         }
-        if done > 0 {
-            let per_spp = start.elapsed().as_secs_f64() / done as f64;
+        if done > resumed {
+            let per_spp = start.elapsed().as_secs_f64() / (done - resumed) as f64;
             pass = pass.min(((limits.longest_pass.as_secs_f64() / per_spp).floor() as u32).max(1));
         }
         let range = done..(done + pass).min(spp);
-        let base = per_pass_sample * done as u64;
+        let base = per_pass_sample * (done - resumed) as u64;
         let next = render_samples(scene, crop, &film, range.clone(), &|d, _| progress(base + d, total), stop);
         let Some(next) = next else { return Ok((film, done, Ending::Stopped)) };
         film = next;
