@@ -143,3 +143,35 @@ fn a_resumed_render_equals_an_uninterrupted_one_bit_for_bit() {
     assert_eq!(code, Some(0), "{err}");
     assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&whole).unwrap());
 }
+
+#[test]
+fn png_output_is_exposed_and_tone_mapped_and_exr_stays_linear() {
+    let dir = common::scene_dir(SCENE, &[]);
+    let render = |out: &str, args: &[&str]| {
+        let run = Command::new(env!("CARGO_BIN_EXE_tessera"))
+            .arg("render")
+            .arg(dir.path().join("scene.toml"))
+            .args(args)
+            .args(["-q", "-o"])
+            .arg(dir.path().join(out))
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        dir.path().join(out)
+    };
+    let exr = render("linear.exr", &["--exposure", "1.5", "--tonemap", "aces"]);
+    let plain = render("plain.exr", &[]);
+    assert_eq!(std::fs::read(&exr).unwrap(), std::fs::read(&plain).unwrap(), "EXR output is never tone-mapped");
+    let linear = tessera::image::read_exr_channels(&exr, &["R", "G", "B"]).unwrap();
+    for (args, tone) in [
+        (vec!["--exposure", "1.5", "--tonemap", "aces"], tessera::image::ToneMap::Aces),
+        (vec!["--exposure", "-2"], tessera::image::ToneMap::Clamp),
+    ] {
+        let gain = args[1].parse::<f32>().unwrap().exp2();
+        let png = image::open(render("shown.png", &args)).unwrap().to_rgb8();
+        for (shown, v) in png.as_raw().iter().zip(&linear.data) {
+            let expected = tessera::color::linear_to_srgb(tone.map(v * gain)) * 255.0;
+            assert!((*shown as f32 - expected).abs() <= 0.51, "{args:?}: {shown} for {expected}");
+        }
+    }
+}

@@ -76,6 +76,14 @@ enum Command {
         /// render's bit for bit.
         #[arg(long)]
         resume: bool,
+        /// PNG output: exposure in stops, applied to the linear radiance before the tone curve
+        /// (EXR output keeps the linear radiance).
+        #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = stops)]
+        exposure: f32,
+        /// PNG output: the tone curve (clamp: values above 1 clip; aces: Narkowicz's fit of the
+        /// ACES filmic curve, highlights roll off).
+        #[arg(long, value_enum, default_value_t = tessera::image::ToneMap::Clamp)]
+        tonemap: tessera::image::ToneMap,
         /// Print nothing but errors.
         #[arg(short, long)]
         quiet: bool,
@@ -292,6 +300,8 @@ pub fn run() -> Result<ExitCode> {
             time_limit,
             checkpoint,
             resume,
+            exposure,
+            tonemap,
             quiet,
         } => {
             let overrides = SceneOverrides { spp, seed, set: set.clone(), ..Default::default() };
@@ -305,7 +315,8 @@ pub fn run() -> Result<ExitCode> {
             let settings = tessera::scene::RenderSettings { spp: 0, ..scene.settings };
             let made_from = [text, format!("{set:?}{settings:?}").into_bytes()].concat();
             let fingerprint = tessera::integrator::fingerprint(&made_from);
-            let control = RenderControl { time_limit, checkpoint, variance, quiet, resume, fingerprint };
+            let display = (tonemap, exposure);
+            let control = RenderControl { time_limit, checkpoint, variance, quiet, resume, fingerprint, display };
             render_to_file(&scene, &output, threads, crop, &aov, control)
         }
         Command::Info { scene } => {
@@ -466,6 +477,15 @@ fn load(path: &Path, overrides: &SceneOverrides, quiet: bool) -> Result<Scene> {
     Ok(scene)
 }
 
+/// An exposure in stops, within +-64 (`--exposure`).
+fn stops(text: &str) -> std::result::Result<f32, String> {
+    let s: f32 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of stops"))?;
+    if !(-64.0..=64.0).contains(&s) {
+        return Err(format!("{s} stops is not within [-64, 64]"));
+    }
+    Ok(s)
+}
+
 /// A positive, finite number of seconds (`--time-limit`, `--checkpoint`).
 fn seconds(text: &str) -> std::result::Result<std::time::Duration, String> {
     let s: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds"))?;
@@ -513,6 +533,8 @@ struct RenderControl {
     resume: bool,
     /// What the render is made from, for its state file ([`tessera::integrator::Checkpoint`]).
     fingerprint: u64,
+    /// `--tonemap` and `--exposure`, for PNG output.
+    display: (tessera::image::ToneMap, f32),
 }
 
 /// The state file of an unfinished render beside its output: `OUTPUT.state`.
@@ -592,7 +614,7 @@ fn render_to_file(
             &|done, _| bar.set_position(done),
             |film, spp| {
                 if control.checkpoint.is_some_and(|every| last_checkpoint.elapsed() >= every) && spp < s.spp {
-                    write_film(output, film, scene, crop, variance)?;
+                    write_film(output, film, scene, crop, variance, control.display)?;
                     checkpoint(film, spp)?;
                     last_checkpoint = Instant::now();
                     bar.set_message(format!("{w}x{h}, checkpoint of {spp} of {} spp written", s.spp));
@@ -608,7 +630,7 @@ fn render_to_file(
         let why = if ending == Ending::Stopped { "interrupted" } else { "the time limit came" };
         return Err(Error::param("render", format!("{why} before one sample per pixel was done: nothing written")));
     }
-    write_film(output, &film, scene, crop, variance)?;
+    write_film(output, &film, scene, crop, variance, control.display)?;
     // An unfinished render leaves its state for --resume; a finished one removes it.
     if ending == Ending::Complete {
         if state.exists() {
@@ -638,8 +660,16 @@ fn render_to_file(
 }
 
 /// Write a render's film (radiance, its AOVs and optionally the variance) to `output`,
-/// atomically; a crop's EXR keeps its place in the frame (the data window), for `tessera merge`.
-fn write_film(output: &Path, film: &tessera::image::Film, scene: &Scene, crop: Crop, variance: bool) -> Result<()> {
+/// atomically; a crop's EXR keeps its place in the frame (the data window), for `tessera merge`;
+/// a PNG shows the radiance through `display` (tone curve, exposure in stops).
+fn write_film(
+    output: &Path,
+    film: &tessera::image::Film,
+    scene: &Scene,
+    crop: Crop,
+    variance: bool,
+    display: (tessera::image::ToneMap, f32),
+) -> Result<()> {
     let mut extra: Vec<(&[&str], tessera::image::Bitmap)> =
         film.aovs().iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();
     if variance {
@@ -653,7 +683,11 @@ fn write_film(output: &Path, film: &tessera::image::Film, scene: &Scene, crop: C
         origin: (crop.x0 as usize, crop.y0 as usize),
         full: (s.width as usize, s.height as usize),
     };
-    tessera::image::write_image_in(output, &film.radiance(), &extra, window)
+    let radiance = match tessera::image::OutputFormat::from_path(output)? {
+        tessera::image::OutputFormat::Png => display.0.apply(&film.radiance(), display.1),
+        tessera::image::OutputFormat::Exr => film.radiance(),
+    };
+    tessera::image::write_image_in(output, &radiance, &extra, window)
 }
 
 fn diff(

@@ -9,6 +9,7 @@ mod io;
 mod merge;
 mod montage;
 mod seams;
+mod tonemap;
 
 pub use bitmap::{Bitmap, ColorSpace};
 pub use film::{Aov, Film, PixelSum};
@@ -19,3 +20,4 @@ pub use io::{
 pub use merge::merge_crops;
 pub use montage::montage;
 pub use seams::{SeamVisibility, seam_visibility};
+pub use tonemap::ToneMap;
