@@ -609,7 +609,7 @@ fn tiles_that_read_the_field_at_their_centres_are_affine_and_keep_to_their_chart
     // right one, F at the left chart's point nearest to the centre (just left of u = 0.5).
     let mut map = Bitmap::new(64, 64, 1);
     map.data.iter_mut().enumerate().for_each(|(k, c)| *c = if k % 64 >= 32 { 1.0 } else { 0.0 });
-    let charted = at(FieldAt::TileCentre, Some(Charts::new(&map, 0.25)));
+    let charted = at(FieldAt::TileCentre, Some(Charts::new(&map, 0.25).unwrap()));
     let near_cut = Vec2::new(0.49, 0.3);
     let field = charted.deformation.as_ref().unwrap();
     let mut crossed = 0;

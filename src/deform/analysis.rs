@@ -149,7 +149,8 @@ pub struct FoldOver {
 /// the same chart (`chart`, row-major from the bottom row; one-sided at a chart's or the map's
 /// border), since a tile never reads across charts. Read at tile centres, F(c) is the texel at
 /// the centre where it lies in the texel's chart, and the point's criterion applies where some
-/// centre does not (the renderer reads F(u) there).
+/// centre does not (the renderer reads F(u) there), and on every texel of a map with more
+/// charts than [`Charts`] relates (the renderer refuses such a map for tile centres).
 pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32, field_at: FieldAt) -> FoldOver {
     let res = f_map.width;
     let f = |i: usize, j: usize| {
@@ -180,14 +181,14 @@ pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32, fiel
         for (k, c) in chart.iter().enumerate() {
             map.values_mut(k % res, res - 1 - k / res)[0] = *c as f32;
         }
-        Charts::new(&map, reach)
+        Charts::new(&map, reach).ok()
     });
     let texel_at = |uv: Vec2| {
         let p = (uv - crate::math::floor2(uv)) * res as f32;
         ((p.x as usize).min(res - 1), (p.y as usize).min(res - 1))
     };
     let centred = |i: usize, j: usize| {
-        let charts = charts.as_ref()?;
+        let charts = charts.as_ref()?.as_ref()?;
         let u = Vec2::new(i as f32 + 0.5, j as f32 + 0.5) / res as f32;
         let mut worst = LookupFold::Fine;
         for k in 0..DIRECTIONS {

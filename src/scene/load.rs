@@ -565,7 +565,10 @@ impl<'a> Loader<'a> {
                     .map(|c| c.length())
                     .fold(0.0, f32::max)
                     * tile_size;
-                let charts = charts.map(|map| Charts::new(&map, reach));
+                let charts = charts
+                    .map(|map| Charts::new(&map, reach))
+                    .transpose()
+                    .map_err(|msg| self.error(format!("{item}.deformation: {msg}")))?;
                 Some(DeformationField::new(factors).read_at(d.field_at.unwrap_or_default(), charts))
             }
         };

@@ -9,6 +9,9 @@ use crate::image::Bitmap;
 use glam::Vec2;
 use std::collections::VecDeque;
 
+/// Most cell visits of [`Charts::new`] (about a second).
+pub const MAX_CELL_VISITS: u64 = 1 << 27;
+
 /// Most charts remembered per cell: the nearest ones.
 const NEAR_CHARTS: usize = 6;
 
@@ -41,8 +44,10 @@ pub struct Charts {
 
 impl Charts {
     /// The charts of `map` (one channel of whole chart numbers, row 0 at v = 1), with the charts
-    /// within `reach` UV units of each cell found (a tile's support radius).
-    pub fn new(map: &Bitmap, reach: f32) -> Charts {
+    /// within `reach` UV units of each cell found (a tile's support radius). An error when
+    /// finding them would visit more than [`MAX_CELL_VISITS`] cells (charts times the cells
+    /// within reach of one: a map of millions of charts, or tiles as large as the map).
+    pub fn new(map: &Bitmap, reach: f32) -> Result<Charts, String> {
         let (width, height) = (map.width, map.height);
         let chart: Vec<u32> = map.data.iter().step_by(map.channels).map(|&c| c as u32).collect();
         let grid = width.max(height).clamp(1, MAX_GRID);
@@ -69,7 +74,15 @@ impl Charts {
             seeds.sort_unstable_by_key(|s| (s.0, s.1));
         }
         // A cell's centre is within half a cell's diagonal of any point in it.
-        let reach_cells = (reach.max(0.0) * grid as f32).ceil() as i64 + 2;
+        let reach_cells = (reach.max(0.0) * grid as f32).ceil().min(grid as f32) as i64 + 2;
+        let charts = seeds.chunk_by(|a, b| a.0 == b.0).count() as u64;
+        let box_cells = ((2 * reach_cells + 1) as u64).pow(2).min((grid * grid) as u64);
+        if charts.saturating_mul(box_cells) > MAX_CELL_VISITS {
+            return Err(format!(
+                "{charts} charts with tiles reaching {reach} UV units would take over {MAX_CELL_VISITS} steps to \
+                 relate: too many charts for field_at = \"tile_centre\""
+            ));
+        }
         let mut near: Vec<Vec<NearChart>> = vec![Vec::new(); grid * grid];
         // Per chart, a breadth-first spread of its seeds over the cells within reach, each cell
         // keeping the seed nearest to its centre among those its neighbours offer.
@@ -117,7 +130,7 @@ impl Charts {
                 list.truncate(NEAR_CHARTS);
             }
         }
-        Charts { width, height, chart, grid, near }
+        Ok(Charts { width, height, chart, grid, near })
     }
 
     /// The texel under `uv` (the map repeats), row-major from row 0 at v = 1.
@@ -167,7 +180,7 @@ mod tests {
 
     #[test]
     fn a_centre_in_another_chart_reads_the_nearest_point_of_the_point_s_chart() {
-        let charts = Charts::new(&halves(), 0.1);
+        let charts = Charts::new(&halves(), 0.1).unwrap();
         assert_eq!((charts.chart(Vec2::new(0.2, 0.3)), charts.chart(Vec2::new(0.7, 0.3))), (0, 1));
         // A centre inside the chart reads itself.
         let centre = Vec2::new(0.3, 0.4);
@@ -181,5 +194,17 @@ mod tests {
         // The map repeats: a centre left of u = 0 lies in chart 1 (at u = 0.98).
         let centre = Vec2::new(-0.02, 0.4);
         assert_eq!(charts.field_point(centre, 1), Some(centre));
+    }
+
+    #[test]
+    fn a_map_of_too_many_charts_is_refused_at_once() {
+        // 512 x 512 texels, each its own chart: 262,144 charts, with tiles reaching a quarter of
+        // the map, would take about 10^12 steps.
+        let mut map = Bitmap::new(512, 512, 1);
+        map.data.iter_mut().enumerate().for_each(|(k, c)| *c = k as f32);
+        let start = std::time::Instant::now();
+        let msg = Charts::new(&map, 0.25).unwrap_err();
+        assert!(msg.contains("too many charts"), "{msg}");
+        assert!(start.elapsed().as_secs() < 10);
     }
 }
