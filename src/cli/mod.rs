@@ -670,22 +670,27 @@ fn write_film(
     variance: bool,
     display: (tessera::image::ToneMap, f32),
 ) -> Result<()> {
-    let mut extra: Vec<(&[&str], tessera::image::Bitmap)> =
-        film.aovs().iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();
-    if variance {
-        extra.push((&["variance.R", "variance.G", "variance.B"], film.variance()));
-    }
-    if !extra.is_empty() && tessera::image::OutputFormat::from_path(output)? == tessera::image::OutputFormat::Png {
-        eprintln!("warning: AOVs are written to EXR outputs only");
-    }
+    use tessera::image::OutputFormat;
+    let (radiance, extra) = match OutputFormat::from_path(output)? {
+        OutputFormat::Png => {
+            if !film.aovs().is_empty() || variance {
+                eprintln!("warning: AOVs are written to EXR outputs only");
+            }
+            (display.0.apply(&film.radiance(), display.1), Vec::new())
+        }
+        OutputFormat::Exr => {
+            let mut extra: Vec<(&[&str], tessera::image::Bitmap)> =
+                film.aovs().iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();
+            if variance {
+                extra.push((&["variance.R", "variance.G", "variance.B"], film.variance()));
+            }
+            (film.radiance(), extra)
+        }
+    };
     let s = scene.settings;
     let window = tessera::image::ExrWindow {
         origin: (crop.x0 as usize, crop.y0 as usize),
         full: (s.width as usize, s.height as usize),
-    };
-    let radiance = match tessera::image::OutputFormat::from_path(output)? {
-        tessera::image::OutputFormat::Png => display.0.apply(&film.radiance(), display.1),
-        tessera::image::OutputFormat::Exr => film.radiance(),
     };
     tessera::image::write_image_in(output, &radiance, &extra, window)
 }

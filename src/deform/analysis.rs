@@ -176,13 +176,7 @@ pub fn fold_over(f_map: &Bitmap, covered: &[u8], chart: &[u32], reach: f32, fiel
     };
     // Read at tile centres: where each centre around (i, j) reads F, as the renderer does
     // (Charts); the worst over the centres, None if one has no point of the chart in reach.
-    let charts = (field_at == FieldAt::TileCentre).then(|| {
-        let mut map = Bitmap::new(res, res, 1);
-        for (k, c) in chart.iter().enumerate() {
-            map.values_mut(k % res, res - 1 - k / res)[0] = *c as f32;
-        }
-        Charts::new(&map, reach).ok()
-    });
+    let charts = (field_at == FieldAt::TileCentre).then(|| Charts::new(&super::chart_map_of(res, chart), reach).ok());
     let texel_at = |uv: Vec2| {
         let p = (uv - crate::math::floor2(uv)) * res as f32;
         ((p.x as usize).min(res - 1), (p.y as usize).min(res - 1))

@@ -49,9 +49,9 @@ pub fn render_in_passes(
     let (w, h) = crop.size();
     debug_assert_eq!(start_film.resolution(), (w as usize, h as usize));
     let per_pass_sample = w as u64 * h as u64;
-    let total = per_pass_sample * spp.saturating_sub(start_film.samples_per_pixel().unwrap_or(0)) as u64;
-    let start = Instant::now();
     let resumed = start_film.samples_per_pixel().unwrap_or(0);
+    let total = per_pass_sample * spp.saturating_sub(resumed) as u64;
+    let start = Instant::now();
     let mut film = start_film;
     let (mut done, mut pass) = (resumed, 1u32);
     while done < spp {

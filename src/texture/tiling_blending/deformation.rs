@@ -127,25 +127,36 @@ impl DeformationField {
         self.field_at
     }
 
-    /// Where the tile centred at `centre` reads F for the point `uv`: None at the point;
-    /// read at tile centres, the centre itself, or (in another chart than `uv`) the nearest
-    /// point of `uv`'s chart ([`super::Charts::field_point`]; None beyond reach).
+    /// The UV chart of the point `uv` whose field tiles read at their centres (None when read
+    /// at the point, or without a chart map): found once per point, for all its tiles.
     #[inline]
-    pub fn tile_field_point(&self, centre: Vec2, uv: Vec2) -> Option<Vec2> {
+    pub fn chart_at(&self, uv: Vec2) -> Option<u32> {
         match (self.field_at, &self.charts) {
-            (FieldAt::Point, _) => None,
-            (FieldAt::TileCentre, None) => Some(centre),
-            (FieldAt::TileCentre, Some(charts)) => charts.field_point(centre, charts.chart(uv)),
+            (FieldAt::TileCentre, Some(charts)) => Some(charts.chart(uv)),
+            _ => None,
         }
     }
 
-    /// The field that the tile centred at `centre` reads at `uv`, given F there (`f_at_uv`, as
-    /// [`DeformationField::at_surface`] gives it with `uv_mirrored`): F at
-    /// [`DeformationField::tile_field_point`] with the surface's handedness at `uv`, or
-    /// `f_at_uv` where that is None.
+    /// Where the tile centred at `centre` reads F for a point of chart `chart`
+    /// ([`DeformationField::chart_at`]): None at the point; read at tile centres, the centre
+    /// itself, or (in another chart) that chart's point nearest to it
+    /// ([`super::Charts::field_point`]; None beyond reach).
     #[inline]
-    pub fn for_tile(&self, centre: Vec2, uv: Vec2, uv_mirrored: Option<bool>, f_at_uv: Mat2) -> Mat2 {
-        self.tile_field_point(centre, uv).map_or(f_at_uv, |p| self.at_surface(p, uv_mirrored))
+    pub fn tile_field_point(&self, centre: Vec2, chart: Option<u32>) -> Option<Vec2> {
+        match (self.field_at, &self.charts, chart) {
+            (FieldAt::Point, ..) => None,
+            (FieldAt::TileCentre, Some(charts), Some(chart)) => charts.field_point(centre, chart),
+            (FieldAt::TileCentre, ..) => Some(centre),
+        }
+    }
+
+    /// The field that the tile centred at `centre` reads for a point of chart `chart`, given F
+    /// at the point (`f_at_uv`, as [`DeformationField::at_surface`] gives it with
+    /// `uv_mirrored`): F at [`DeformationField::tile_field_point`] with the surface's
+    /// handedness at the point, or `f_at_uv` where that is None.
+    #[inline]
+    pub fn for_tile(&self, centre: Vec2, chart: Option<u32>, uv_mirrored: Option<bool>, f_at_uv: Mat2) -> Mat2 {
+        self.tile_field_point(centre, chart).map_or(f_at_uv, |p| self.at_surface(p, uv_mirrored))
     }
 
     /// F at `uv`.

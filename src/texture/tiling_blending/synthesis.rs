@@ -69,6 +69,7 @@ impl Synthesis {
         let k = self.tiles_per_point();
         let tiles = self.tiling.tiles(ctx.uv, self.tile_size);
         let f = self.deformation.as_ref().map(|d| d.at_surface(ctx.uv, ctx.uv_mirrored));
+        let chart = self.deformation.as_ref().and_then(|d| d.chart_at(ctx.uv));
         let mut out = [TileLookup::default(); MAX_LOOKUPS];
         for i in 0..k {
             let tile = &tiles[i];
@@ -78,7 +79,7 @@ impl Synthesis {
             out[i].weight = tile.weight;
             out[i].ctx = match (f, &self.deformation) {
                 (Some(f), Some(field)) => {
-                    let f = field.for_tile(tile.centre, ctx.uv, ctx.uv_mirrored, f);
+                    let f = field.for_tile(tile.centre, chart, ctx.uv_mirrored, f);
                     TexCtx { uv: f * offset + h, duv_dx: f * ctx.duv_dx, duv_dy: f * ctx.duv_dy, uv_mirrored: None }
                 }
                 _ => TexCtx { uv: offset + h, uv_mirrored: None, ..*ctx },
