@@ -22,7 +22,7 @@ fn accel(c: &mut Criterion) {
     let camera_rays: Vec<Ray> = (0..w * h)
         .map(|i| {
             let film = Vec2::new((i % w) as f32 * 4.0 + 2.0, (i / w) as f32 * 4.0 + 2.0);
-            scene.camera.generate_ray(film).0
+            scene.camera.generate_ray(film, glam::Vec2::ZERO).0
         })
         .collect();
     let bounce_rays: Vec<Ray> = camera_rays

@@ -163,6 +163,51 @@ fn absurd_parameters_are_rejected() {
 }
 
 #[test]
+fn bad_lights_and_cameras_name_the_parameter() {
+    let light = |body: &str| format!("{CAMERA}[[lights]]\n{body}\n");
+    error_of(&light("type = \"point\"\nposition = [0, 1, 0]\nintensity = -2"), &[], &["lights[0]", "intensity"]);
+    error_of(&light("type = \"point\"\nposition = [0, 1, 0]"), &[], &["intensity"]);
+    error_of(&light("type = \"lamp\"\nposition = [0, 1, 0]"), &[], &["unknown variant `lamp`"]);
+    let spot = "type = \"spot\"\nposition = [0, 1, 0]\nintensity = 1";
+    error_of(&light(spot), &[], &["lights[0]", "exactly one of direction and target"]);
+    error_of(&light(&format!("{spot}\ntarget = [0, 1, 0]")), &[], &["lights[0]", "no length"]);
+    error_of(
+        &light(&format!("{spot}\ndirection = [0, -1, 0]\ncutoff_angle = 20\nbeam_width = 30")),
+        &[],
+        &["lights[0]", "beam width 30"],
+    );
+    error_of(&light("type = \"directional\"\ndirection = [0, 0, 0]\nirradiance = 1"), &[], &["lights[0]", "no length"]);
+    error_of(
+        &light("type = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1\nangular_diameter = 0"),
+        &[],
+        &["lights[0]", "needs a disc"],
+    );
+    error_of(
+        &light("type = \"sun\"\ndirection = [0, -1, 0]\nirradiance = 1e14\nangular_diameter = 0.001"),
+        &[],
+        &["lights[0]", "radiance"],
+    );
+    let camera = |keys: &str| format!("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n{keys}\n");
+    error_of(&camera("projection = \"orthographic\""), &[], &["camera.extent is required"]);
+    error_of(&camera("projection = \"orthographic\"\nextent = -1"), &[], &["camera.extent"]);
+    error_of(&camera("projection = \"orthographic\"\nfov = 30"), &[], &["camera.fov applies to a perspective"]);
+    error_of(&camera("fov = 30\nextent = 2"), &[], &["camera.extent applies to an orthographic"]);
+    error_of(&camera("fov = 30\naperture_radius = 0.1"), &[], &["aperture_radius and focus_distance"]);
+    error_of(&camera("fov = 30\naperture_radius = 0.1\nfocus_distance = 0"), &[], &["camera.focus_distance"]);
+    error_of(
+        &camera("projection = \"orthographic\"\nextent = 2\naperture_radius = 0.1\nfocus_distance = 1"),
+        &[],
+        &["thin lens needs a perspective camera"],
+    );
+    error_of(&camera("fov = 30\nnear_clip = -1"), &[], &["camera.near_clip"]);
+    error_of(
+        &format!("{CAMERA}[[shapes]]\ntype = \"cube\"\nlights = false\n"),
+        &[],
+        &["lights and light_scale apply to gltf shapes only"],
+    );
+}
+
+#[test]
 fn unknown_names_list_the_known_ones() {
     error_of(
         &format!("{CAMERA}[materials.metal]\ntype = \"diffuse\"\n[[shapes]]\ntype = \"cube\"\nmaterial = \"metl\"\n"),

@@ -154,6 +154,50 @@ fn two_sided_and_normal_mapped_materials_are_wrapped() {
         && n.children().any(|c| c.attribute("type") == Some("roughconductor"))));
 }
 
+/// The sensor each camera becomes, and the emitters of point, spot, directional lights and suns
+/// (the golden scenes `punctual_lights` and `thin_lens` check that Mitsuba renders them alike).
+#[test]
+fn cameras_and_punctual_lights_export_as_their_mitsuba_plugins() {
+    let lights = "[[lights]]\ntype = \"point\"\nposition = [1, 2, 3]\nintensity = 4\n\
+                  [[lights]]\ntype = \"spot\"\nposition = [0, 3, 0]\ndirection = [0, -1, 0]\nintensity = 2\n\
+                  cutoff_angle = 40\nfalloff = \"gltf\"\n\
+                  [[lights]]\ntype = \"sun\"\ndirection = [0, -1, 1]\nirradiance = 5\n\
+                  [[shapes]]\ntype = \"cube\"\n";
+    let ortho = format!(
+        "[render]\nwidth = 200\nheight = 100\n[camera]\nprojection = \"orthographic\"\nextent = 3\n\
+         eye = [0, 0, 5]\ntarget = [0, 0, 0]\nnear_clip = 0.5\n{lights}"
+    );
+    let dir = common::scene_dir(&ortho, &[]);
+    let scene = common::load(dir.path()).unwrap();
+    let report = export_mitsuba(&scene, &dir.path().join("out"), 16).unwrap();
+    let xml = std::fs::read_to_string(dir.path().join("out/scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&xml).expect("well-formed XML");
+    let sensor = doc.descendants().find(|n| n.has_tag_name("sensor")).unwrap();
+    assert_eq!(sensor.attribute("type"), Some("orthographic"));
+    assert_eq!(attr(sensor, "near_clip"), Some("0.5"));
+    // Mitsuba's film spans x in [-1, 1] before to_world: scaled by the half-width, 3 units.
+    let matrix = sensor.descendants().find(|n| n.has_tag_name("matrix")).unwrap().attribute("value").unwrap();
+    let m: Vec<f32> = matrix.split_whitespace().map(|v| v.parse().unwrap()).collect();
+    assert!((Vec3::new(m[0], m[4], m[8]).length() - 3.0).abs() < 1e-5, "{matrix}");
+    let emitters: Vec<_> = doc.descendants().filter(|n| n.has_tag_name("emitter")).collect();
+    let kinds: Vec<_> = emitters.iter().map(|e| e.attribute("type").unwrap()).collect();
+    assert_eq!(kinds, ["point", "spot", "directional"]);
+    assert_eq!(attr(emitters[1], "cutoff_angle").map(|v| v.parse::<f32>().unwrap().round()), Some(40.0));
+    assert_eq!(attr(emitters[1], "beam_width").map(|v| v.parse::<f32>().unwrap().round()), Some(30.0));
+    let warnings = report.warnings.join("\n");
+    assert!(warnings.contains("point light 1") && warnings.contains("spot falloff"), "{warnings}");
+    assert!(warnings.contains("distant light 0") && warnings.contains("no sun disc"), "{warnings}");
+
+    let lens = format!(
+        "[camera]\nfov = 30\neye = [0, 0, 5]\ntarget = [0, 0, 0]\naperture_radius = 0.1\nfocus_distance = 4\n{lights}"
+    );
+    let (_dir, _out, xml) = export(&lens, &[]);
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let sensor = doc.descendants().find(|n| n.has_tag_name("sensor")).unwrap();
+    assert_eq!(sensor.attribute("type"), Some("thinlens"));
+    assert_eq!((attr(sensor, "aperture_radius"), attr(sensor, "focus_distance")), (Some("0.1"), Some("4")));
+}
+
 #[test]
 fn pbr_materials_are_not_exported_silently() {
     let dir = common::scene_dir(

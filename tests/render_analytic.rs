@@ -5,6 +5,7 @@
 mod common;
 
 use common::{mean_and_error, render_film, scene};
+use std::f64::consts::PI;
 
 fn assert_mean(toml: &str, files: &[(&str, &[u8])], expected: f64, margin: f64, what: &str) {
     let (_dir, scene) = scene(toml, files);
@@ -238,7 +239,7 @@ fn normal_mapped_mirror_under_uniform_sky_matches_its_model() {
         [materials.m]\ntype = \"conductor\"\nmaterial = \"none\"\nalpha = 0.3\nnormal_map = \"n\"\n\
         [[shapes]]\ntype = \"rectangle\"\nmaterial = \"m\"\ntransform = [{ rotate = [1, 0, 0], angle = -90 }]\n";
     let (_dir, scene) = common::scene(toml, &[("n.png", &png)]);
-    let (ray, _) = scene.camera.generate_ray(Vec2::new(4.5, 4.5));
+    let (ray, _) = scene.camera.generate_ray(Vec2::new(4.5, 4.5), glam::Vec2::ZERO);
     let si = scene.intersect(&ray).unwrap();
     let material = &scene.materials[scene.shape_of(si.triangle).material as usize];
     let ctx = TexCtx { uv: si.uv, ..Default::default() };
@@ -303,4 +304,112 @@ fn depth_and_position_aovs_are_the_first_hit_s() {
         // And the mean position's distance is within the same bounds.
         assert!(p.truncate().length() <= hi + 1e-4 && p.truncate().length() >= 3.0, "({x}, {y}): {p}");
     }
+}
+
+/// A diffuse floor (albedo rho, facing +y) seen straight down through a 1-degree field of view
+/// around the origin, with direct light only, lit by `lights` (TOML) and `shapes` (extra
+/// TOML shapes). Its radiance is rho / pi times the irradiance at the origin.
+fn lit_floor(rho: f64, lights: &str, shapes: &str) -> String {
+    format!(
+        r#"
+        [render]
+        width = 8
+        height = 8
+        spp = 256
+        max_depth = 2
+        [camera]
+        fov = 1
+        eye = [0, 0.5, 0]
+        target = [0, 0, 0]
+        up = [0, 0, -1]
+        [materials.floor]
+        type = "diffuse"
+        reflectance = {rho}
+        [[shapes]]
+        type = "rectangle"
+        material = "floor"
+        transform = [{{ scale = 10 }}, {{ rotate = [1, 0, 0], angle = -90 }}]
+        {shapes}
+        {lights}
+        "#
+    )
+}
+
+/// Point and spot lights at height h = 2 over the floor: E = I s(theta) / h^2, with the spot's
+/// profile s at the angle theta = 20 degrees between its axis and the floor's origin (beam 10,
+/// cutoff 30): Mitsuba's (30 - 20) / (30 - 10) = 1/2, glTF's ((cos 20 - cos 30) /
+/// (cos 10 - cos 30))^2. Delta lights are reached by light sampling alone, at full weight.
+#[test]
+fn point_and_spot_lights_over_a_floor_match_the_inverse_square_law() {
+    let (rho, i, h) = (0.6, 5.0, 2.0);
+    let point = "[[lights]]\ntype = \"point\"\nposition = [0, 2, 0]\nintensity = 5";
+    assert_mean(&lit_floor(rho, point, ""), &[], rho / PI * i / (h * h), 1e-4, "point light");
+    let t = 20f64.to_radians();
+    let (sin, cos) = t.sin_cos();
+    let spot = |falloff: &str| {
+        format!(
+            "[[lights]]\ntype = \"spot\"\nposition = [0, 2, 0]\ndirection = [{sin}, {}, 0]\nintensity = 5\n\
+             cutoff_angle = 30\nbeam_width = 10\nfalloff = \"{falloff}\"",
+            -cos
+        )
+    };
+    let expected = rho / PI * i * 0.5 / (h * h);
+    assert_mean(&lit_floor(rho, &spot("mitsuba"), ""), &[], expected, 1e-4, "Mitsuba's spot");
+    let (c10, c30) = (10f64.to_radians().cos(), 30f64.to_radians().cos());
+    let s = ((cos - c30) / (c10 - c30)).powi(2);
+    assert_mean(&lit_floor(rho, &spot("gltf"), ""), &[], rho / PI * i * s / (h * h), 1e-4, "glTF's spot");
+}
+
+/// A directional light and suns 50 degrees from the zenith: E = E_n cos 50 (exact for a disc
+/// wholly above the horizon). The 30-degree sun is large enough that BSDF samples hit it often,
+/// so the two strategies' MIS weights must add up; the real sun's 0.533 degrees are reached by
+/// light sampling almost alone.
+#[test]
+fn directional_lights_and_suns_over_a_floor_match_the_cosine_law() {
+    let (rho, e) = (0.5, 3.0);
+    let t = 50f64.to_radians();
+    let direction = format!("[{}, {}, 0]", -t.sin(), -t.cos());
+    let expected = rho / PI * e * t.cos();
+    let directional = format!("[[lights]]\ntype = \"directional\"\ndirection = {direction}\nirradiance = 3");
+    assert_mean(&lit_floor(rho, &directional, ""), &[], expected, 1e-4, "directional light");
+    for diameter in [0.533, 30.0] {
+        let sun = format!(
+            "[[lights]]\ntype = \"sun\"\ndirection = {direction}\nirradiance = 3\nangular_diameter = {diameter}"
+        );
+        assert_mean(&lit_floor(rho, &sun, ""), &[], expected, 1e-4, &format!("sun of {diameter} degrees"));
+    }
+}
+
+/// glTF `KHR_lights_punctual`, in the spec's units: a point light of 683 candela with a range
+/// of 4 at height 2, and a spot of 683 cd pointing straight down (node rotated -90 degrees about
+/// x; local -z is the spot's axis) at height 1 through the shape's own translation. At 683 lm/W
+/// these are 1 W/sr; the range windows the point by (1 - (2/4)^4)^2.
+#[test]
+fn gltf_punctual_lights_arrive_in_the_spec_s_units_and_range() {
+    let gltf = r#"{
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "intensity": 683, "range": 4},
+            {"type": "spot", "intensity": 683, "color": [0.5, 0.5, 0.5],
+             "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.6}}
+        ]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"translation": [0, 1.5, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"translation": [0, 0.5, 0], "rotation": [-0.70710678, 0, 0, 0.70710678],
+             "extensions": {"KHR_lights_punctual": {"light": 1}}}
+        ]
+    }"#;
+    let rho = 0.5;
+    let shape = "[[shapes]]\ntype = \"gltf\"\nfilename = \"lights.gltf\"\ntransform = [{ translate = [0, 0.5, 0] }]";
+    let window = (1.0 - 0.5f64.powi(4)).powi(2);
+    let expected = rho / PI * (window / 4.0 + 0.5 / 1.0);
+    assert_mean(&lit_floor(rho, "", shape), &[("lights.gltf", gltf.as_bytes())], expected, 1e-4, "glTF lights");
+    let without = shape.replace("transform", "lights = false\ntransform");
+    // Without its lights the file holds nothing to render: an error that says so.
+    let dir = common::scene_dir(&lit_floor(rho, "", &without), &[("lights.gltf", gltf.as_bytes())]);
+    let err = common::load(dir.path()).err().expect("lights = false leaves the file's lights out").to_string();
+    assert!(err.contains("lights.gltf") && err.contains("no triangle meshes and no punctual lights"), "{err}");
 }

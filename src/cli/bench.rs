@@ -34,7 +34,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 use tessera::accel::{Accel, AccelKind};
-use tessera::camera::{FovAxis, PerspectiveCamera};
+use tessera::camera::{Camera, CameraModel, FovAxis};
 use tessera::error::{Error, Result};
 use tessera::geometry::{Frame, Ray, offset_ray_origin, shapes};
 use tessera::image::{Bitmap, ColorSpace, read_bitmap};
@@ -144,10 +144,12 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
     let accel = &builds[0].1;
 
     // Primary rays: 1024 x 1024 pixel centres of a camera looking at the mesh.
-    let view = PerspectiveCamera::look_at(glam::Vec3::new(0.4, 0.9, 3.2), glam::Vec3::ZERO, glam::Vec3::Y)?;
-    let camera = PerspectiveCamera::new(view, 45.0, FovAxis::Y, 1024, 1024, 1)?;
+    let view = Camera::look_at(glam::Vec3::new(0.4, 0.9, 3.2), glam::Vec3::ZERO, glam::Vec3::Y)?;
+    let camera = Camera::new(view, CameraModel::pinhole(45.0, FovAxis::Y), 1024, 1024, 1)?;
     let primary: Vec<Ray> = (0..1024 * 1024)
-        .map(|i| camera.generate_ray(glam::Vec2::new((i % 1024) as f32 + 0.5, (i / 1024) as f32 + 0.5)).0)
+        .map(|i| {
+            camera.generate_ray(glam::Vec2::new((i % 1024) as f32 + 0.5, (i / 1024) as f32 + 0.5), glam::Vec2::ZERO).0
+        })
         .collect();
     // Incoherent rays: a cosine-distributed bounce from each primary hit.
     let incoherent: Vec<Ray> = primary
@@ -171,7 +173,7 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
             let pixel = i / 8;
             let jitter = Sampler::new(2, pixel as u64, i as u32 % 8).next_2d();
             let film = glam::Vec2::new((pixel % 512) as f32 * 2.0, (pixel / 512) as f32 * 2.0) + jitter;
-            camera.generate_ray(film).0
+            camera.generate_ray(film, glam::Vec2::ZERO).0
         })
         .collect();
     for (kind, accel, build_seconds) in &builds {

@@ -290,7 +290,7 @@ struct GpuViews {
 #[cfg(feature = "gpu")]
 fn draw_on_gpu(
     scene: &tessera::scene::Scene,
-    camera: &tessera::camera::PerspectiveCamera,
+    camera: &tessera::camera::Camera,
     texture: &Texture,
     args: &GpuViewArgs,
 ) -> Result<GpuViews> {
@@ -317,7 +317,7 @@ fn draw_on_gpu(
 #[cfg(not(feature = "gpu"))]
 fn draw_on_gpu(
     _scene: &tessera::scene::Scene,
-    _camera: &tessera::camera::PerspectiveCamera,
+    _camera: &tessera::camera::Camera,
     texture: &Texture,
     args: &GpuViewArgs,
 ) -> Result<GpuViews> {

@@ -778,7 +778,15 @@ fn print_info(scene: &Scene) {
         Some(tessera::light::Environment::Map(_)) => "equirectangular map".to_string(),
     };
     let emissive = g.triangle_shape.iter().filter(|&&s| g.shapes[s as usize].light.is_some()).count();
-    println!("lights     {} area ({emissive} triangles), environment: {env}", scene.lights.area.len());
+    let l = &scene.lights;
+    let spots = l.points.iter().filter(|p| p.spot.is_some()).count();
+    let suns = l.distant.iter().filter(|d| !d.is_delta()).count();
+    println!(
+        "lights     {} area ({emissive} triangles), {} point, {spots} spot, {} directional, {suns} sun; environment: {env}",
+        l.area.len(),
+        l.points.len() - spots,
+        l.distant.len() - suns
+    );
     println!("memory     {:.1} MiB (geometry, BVH, textures)", scene.memory_bytes() as f64 / (1 << 20) as f64);
 }
 

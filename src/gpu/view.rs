@@ -4,7 +4,7 @@
 
 use super::synthesis::{SynthesisGroup, layout_entry, shader_module, time_batches, uniform_entry, wait};
 use super::{Gpu, GpuError};
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::integrator::primary::{Derivatives, PrimaryView, ViewParams, ViewVertex, near_plane, view_geometry};
 use crate::scene::Scene;
 use crate::shader::VIEW_ENTRY_POINTS;
@@ -56,10 +56,11 @@ impl<'g> GpuView<'g> {
     pub fn new(
         gpu: &'g Gpu,
         scene: &Scene,
-        camera: &PerspectiveCamera,
+        camera: &Camera,
         texture: &TilingBlending,
         hardware: Option<HardwareSampling>,
     ) -> Result<Self, GpuError> {
+        camera.require_pinhole("the GPU view").map_err(|e| GpuError(e.to_string()))?;
         let device = &gpu.device;
         let (width, height) = camera.resolution();
         let limits = device.limits();

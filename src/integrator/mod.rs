@@ -122,7 +122,10 @@ pub fn render_samples(
                 let camera_sample = |i: u32| {
                     let mut sampler = key.sampler(i);
                     let film_pos = Vec2::new(px as f32, py as f32) + sampler.next_2d();
-                    let (ray, diff) = scene.camera.generate_ray(film_pos);
+                    // A thin lens takes the next two dimensions; other cameras none, so that
+                    // their paths draw the same numbers as before lenses existed.
+                    let lens = if scene.camera.needs_lens_sample() { sampler.next_2d() } else { Vec2::ZERO };
+                    let (ray, diff) = scene.camera.generate_ray(film_pos, lens);
                     (ray, diff, sampler)
                 };
                 // The camera rays of up to PACKET samples at a time are traced together, as a

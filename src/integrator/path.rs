@@ -1,5 +1,5 @@
 //! The path tracer: unidirectional, with next-event estimation and multiple importance sampling
-//! (power heuristic) for area and environment lights, and Russian roulette.
+//! (power heuristic) for the lights that paths can hit, and Russian roulette.
 //!
 //! Path length follows Mitsuba 3's count: `max_depth` is the number of path segments, so 1
 //! shows only emitters seen directly and 2 adds direct lighting. Russian roulette starts once
@@ -94,11 +94,8 @@ impl<'a> PathTracer<'a> {
         loop {
             let hit = if depth == 0 { primary } else { scene.accel.intersect(&ray) };
             let Some(hit) = hit else {
-                if let Some(env) = &lights.environment {
-                    let d = ray.d.normalize();
-                    let w = if prev.delta { 1.0 } else { power_heuristic(prev.pdf, lights.environment_pdf(d)) };
-                    radiance += throughput * env.radiance(d) * w;
-                }
+                let bsdf_pdf = (!prev.delta).then_some(prev.pdf);
+                radiance += throughput * lights.arriving_from_infinity(ray.d.normalize(), bsdf_pdf);
                 break;
             };
             let mut si = scene.interaction(&ray, &hit);
@@ -163,7 +160,7 @@ impl<'a> PathTracer<'a> {
                             None => si.spawn_ray(ls.wi),
                         };
                         if !scene.occluded(&shadow) {
-                            let w = power_heuristic(ls.pdf, bsdf.pdf(wo, wi));
+                            let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf.pdf(wo, wi)) };
                             radiance += throughput * f * ls.radiance * (w / ls.pdf);
                         }
                     }

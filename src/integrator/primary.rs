@@ -7,7 +7,7 @@
 //! footprint of its ray differentials, as the path tracer looks up a material's albedo at a
 //! camera ray's first hit. Every surface shows the texture, whatever its material.
 
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::error::Result;
 use crate::geometry::{Ray, SurfaceInteraction};
 use crate::image::Bitmap;
@@ -42,8 +42,8 @@ impl PrimaryView {
 
 /// The texture lookup that the camera ray through film point `film` makes on the surface it
 /// meets, and that surface.
-pub fn primary_lookup(scene: &Scene, camera: &PerspectiveCamera, film: Vec2) -> Option<(TexCtx, SurfaceInteraction)> {
-    let (ray, diff) = camera.generate_ray(film);
+pub fn primary_lookup(scene: &Scene, camera: &Camera, film: Vec2) -> Option<(TexCtx, SurfaceInteraction)> {
+    let (ray, diff) = camera.generate_ray(film, glam::Vec2::ZERO);
     let hit = scene.accel.intersect(&ray)?;
     let mut si = scene.interaction(&ray, &hit);
     if !si.footprint_from_differential(ray.o, &diff) {
@@ -56,7 +56,7 @@ pub fn primary_lookup(scene: &Scene, camera: &PerspectiveCamera, film: Vec2) -> 
 
 /// `texture` as `camera` sees it on `scene`'s surfaces at pixel centres (rows in parallel; the
 /// result does not depend on the thread count).
-pub fn primary_view(scene: &Scene, camera: &PerspectiveCamera, texture: &Texture) -> PrimaryView {
+pub fn primary_view(scene: &Scene, camera: &Camera, texture: &Texture) -> PrimaryView {
     let (width, height) = camera.resolution();
     let (width, height) = (width as usize, height as usize);
     let mut view = PrimaryView::new(width, height);
@@ -89,7 +89,7 @@ pub fn primary_view(scene: &Scene, camera: &PerspectiveCamera, texture: &Texture
 /// channels and the two directions, the footprint kept): the difference that a view whose UVs
 /// come from other arithmetic (a rasteriser's interpolation, another ray-triangle test, fused
 /// multiply-adds) must expect from the UVs' last bits alone.
-pub fn ulp_sensitivity(scene: &Scene, camera: &PerspectiveCamera, texture: &Texture) -> Vec<f32> {
+pub fn ulp_sensitivity(scene: &Scene, camera: &Camera, texture: &Texture) -> Vec<f32> {
     let (width, height) = camera.resolution();
     let (width, height) = (width as usize, height as usize);
     let mut sensitivity = vec![0.0; width * height];
@@ -185,11 +185,11 @@ impl ViewDifference {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ViewParams {
-    /// [`PerspectiveCamera::clip_from_world`], column-major.
+    /// [`Camera::clip_from_world`], column-major.
     pub clip_from_world: [f32; 16],
     /// The camera's position (w = 0).
     pub eye: [f32; 4],
-    /// [`PerspectiveCamera::film_directions`]: through the film's top-left corner (w = 0).
+    /// [`Camera::film_directions`]: through the film's top-left corner (w = 0).
     pub corner_direction: [f32; 4],
     /// Added per pixel right (w = 0).
     pub pixel_step_x: [f32; 4],
@@ -199,7 +199,7 @@ pub struct ViewParams {
 
 impl ViewParams {
     /// The block of `camera`, with the rasteriser's near plane at `near`.
-    pub fn new(camera: &PerspectiveCamera, near: f32) -> Self {
+    pub fn new(camera: &Camera, near: f32) -> Self {
         let (corner, [step_x, step_y]) = camera.film_directions();
         ViewParams {
             clip_from_world: camera.clip_from_world(near).to_cols_array(),

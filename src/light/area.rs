@@ -55,7 +55,7 @@ impl AreaLight {
             return None;
         }
         let pdf = dist2 / (cos_light * self.area);
-        Some(LightSample { wi, radiance: self.radiance, pdf, point: Some(offset_ray_origin(q, n, -wi)) })
+        Some(LightSample { wi, radiance: self.radiance, pdf, point: Some(offset_ray_origin(q, n, -wi)), delta: false })
     }
 
     /// Solid-angle density at `p` of sampling the point `q` with geometric normal `n`; zero where

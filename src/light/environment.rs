@@ -157,7 +157,7 @@ impl Environment {
                 (wi, pdf)
             }
         };
-        Some(LightSample { wi, radiance: self.radiance(wi), pdf, point: None })
+        Some(LightSample { wi, radiance: self.radiance(wi), pdf, point: None, delta: false })
     }
 
     /// Solid-angle density of [`Environment::sample`] returning `d`.

@@ -1,11 +1,22 @@
-//! Light sources: emissive triangle meshes and the environment, and the choice among them for
-//! next-event estimation (uniform over lights, as Mitsuba 3 does).
+//! Light sources: emissive triangle meshes, point and spot lights, directional lights and suns,
+//! and the environment, and the choice among them for next-event estimation (uniform over
+//! lights, as Mitsuba 3 does).
+//!
+//! Delta lights (points, spots, directional lights) are reached by next-event estimation only,
+//! with full weight; lights that paths can also hit (meshes, suns, the environment) weigh the two
+//! strategies by the power heuristic.
 
 mod area;
+mod distant;
 mod environment;
+mod point;
 
 pub use area::AreaLight;
+pub use distant::DistantLight;
 pub use environment::{Environment, EnvironmentMap};
+pub use point::{PointLight, SpotCone, SpotFalloff};
+
+use crate::sampling::power_heuristic;
 
 use crate::color::Rgb;
 use glam::{Vec2, Vec3};
@@ -19,8 +30,11 @@ pub struct LightSample {
     pub radiance: Rgb,
     /// Solid-angle density at the reference point, including the choice of this light.
     pub pdf: f32,
-    /// The sampled point, already offset off the light's surface; None for the environment.
+    /// The sampled point, already offset off the light's surface; None for lights at infinity.
     pub point: Option<Vec3>,
+    /// Whether the light is a delta light (`pdf` then is a discrete probability, and no BSDF
+    /// sample can reach it).
+    pub delta: bool,
 }
 
 /// All lights of a scene.
@@ -28,6 +42,10 @@ pub struct LightSample {
 pub struct Lights {
     /// Emissive meshes.
     pub area: Vec<AreaLight>,
+    /// Point and spot lights.
+    pub points: Vec<PointLight>,
+    /// Directional lights and suns.
+    pub distant: Vec<DistantLight>,
     /// The environment, if any.
     pub environment: Option<Environment>,
 }
@@ -35,7 +53,17 @@ pub struct Lights {
 impl Lights {
     /// Number of lights NEE chooses among.
     pub fn count(&self) -> usize {
-        self.area.len() + usize::from(self.environment.is_some())
+        self.area.len() + self.points.len() + self.distant.len() + usize::from(self.environment.is_some())
+    }
+
+    /// Whether any light emits anything.
+    pub fn any_emit(&self) -> bool {
+        let environment_emits = match &self.environment {
+            None => false,
+            Some(Environment::Constant(c)) => c.max_element() > 0.0,
+            Some(Environment::Map(_)) => true,
+        };
+        !self.area.is_empty() || !self.points.is_empty() || !self.distant.is_empty() || environment_emits
     }
 
     /// Probability of choosing any one light.
@@ -51,17 +79,36 @@ impl Lights {
             return None;
         }
         let i = ((u_select * n as f32) as usize).min(n - 1);
-        let mut s = match self.area.get(i) {
-            Some(light) => light.sample(p, u)?,
-            None => self.environment.as_ref()?.sample(u)?,
+        let (points, distant) = (self.area.len(), self.area.len() + self.points.len());
+        let environment = distant + self.distant.len();
+        let mut s = match i {
+            i if i < points => self.area[i].sample(p, u)?,
+            i if i < distant => self.points[i - points].sample(p)?,
+            i if i < environment => self.distant[i - distant].sample(u)?,
+            _ => self.environment.as_ref()?.sample(u)?,
         };
         s.pdf *= self.selection_pdf();
         Some(s)
     }
 
-    /// Density with which [`Lights::sample`] picks direction `wi` towards the environment.
-    pub fn environment_pdf(&self, wi: Vec3) -> f32 {
-        self.environment.as_ref().map_or(0.0, |e| e.pdf(wi) * self.selection_pdf())
+    /// Radiance arriving along unit direction `d` from the lights at infinity (the environment
+    /// and suns), seen by a path that left its last vertex along `d` with BSDF density
+    /// `bsdf_pdf`, weighted against next-event estimation by the power heuristic; None for a
+    /// direction sampled with a delta (the camera's, or a smooth BSDF's): full weight.
+    pub fn arriving_from_infinity(&self, d: Vec3, bsdf_pdf: Option<f32>) -> Rgb {
+        let weight =
+            |light_pdf: f32| bsdf_pdf.map_or(1.0, |pdf| power_heuristic(pdf, light_pdf * self.selection_pdf()));
+        let mut radiance = Rgb::ZERO;
+        if let Some(env) = &self.environment {
+            radiance += env.radiance(d) * weight(env.pdf(d));
+        }
+        for sun in &self.distant {
+            let l = sun.radiance(d);
+            if l != Rgb::ZERO {
+                radiance += l * weight(sun.pdf(d));
+            }
+        }
+        radiance
     }
 
     /// Density with which [`Lights::sample`] reaches point `p_light` (geometric normal

@@ -42,6 +42,24 @@ pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
 /// Density of [`square_to_uniform_sphere`].
 pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
 
+/// Uniform direction in the cone of directions within angle theta_max of +z, given
+/// 1 - cos theta_max (which a small cone, such as the sun's, needs exactly: 1 - cos in f32
+/// would lose half its digits at a quarter of a degree).
+#[inline]
+pub fn square_to_uniform_cone(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
+    let one_minus_z = u.y * one_minus_cos_max;
+    let r = (one_minus_z * (2.0 - one_minus_z)).max(0.0).sqrt();
+    let (s, c) = (2.0 * PI * u.x).sin_cos();
+    Vec3::new(r * c, r * s, 1.0 - one_minus_z)
+}
+
+/// Density of [`square_to_uniform_cone`] inside the cone: one over its solid angle,
+/// 2 pi (1 - cos theta_max).
+#[inline]
+pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * one_minus_cos_max)
+}
+
 /// Uniform point on a triangle, as barycentric weights (b1, b2) of its second and third
 /// vertices (the square-root parameterisation).
 #[inline]

@@ -20,6 +20,9 @@ pub struct SceneDesc {
     pub camera: CameraDesc,
     /// Light from infinitely far away.
     pub environment: Option<EnvironmentDesc>,
+    /// Point, spot, directional lights and suns.
+    #[serde(default)]
+    pub lights: Vec<LightDesc>,
     /// Named textures.
     #[serde(default)]
     pub textures: BTreeMap<String, TextureDesc>,
@@ -56,14 +59,25 @@ impl Default for RenderDesc {
     }
 }
 
-/// `[camera]`: a perspective camera, placed by eye/target/up, a matrix, or a glTF file's camera.
+/// `[camera]`: a perspective or orthographic camera, placed by eye/target/up, a matrix, or a
+/// glTF file's camera.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
-    /// Field of view in degrees along `fov_axis`.
+    /// `perspective` (default, or the glTF camera's) or `orthographic`.
+    pub projection: Option<ProjectionKind>,
+    /// Perspective: field of view in degrees along `fov_axis`.
     pub fov: Option<f32>,
-    /// Which axis `fov` spans (default y).
+    /// Orthographic: the image's size along `fov_axis` in world units.
+    pub extent: Option<f32>,
+    /// Which axis `fov` or `extent` spans (default y).
     pub fov_axis: Option<FovAxis>,
+    /// Thin lens: radius of the aperture (with `focus_distance`; default none, a pinhole).
+    pub aperture_radius: Option<f32>,
+    /// Thin lens: distance of the plane in focus along the view axis.
+    pub focus_distance: Option<f32>,
+    /// Distance along the view axis where rays start (default 0, or a glTF camera's znear).
+    pub near_clip: Option<f32>,
     /// Camera position.
     pub eye: Option<[f32; 3]>,
     /// Point the camera looks at.
@@ -76,6 +90,16 @@ pub struct CameraDesc {
     pub gltf: Option<String>,
     /// Which of the glTF file's camera nodes (default the first).
     pub index: Option<usize>,
+}
+
+/// Camera projections.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProjectionKind {
+    /// Rays from one point (or a thin lens).
+    Perspective,
+    /// Parallel rays.
+    Orthographic,
 }
 
 /// `[environment]`.
@@ -99,6 +123,63 @@ pub enum EnvironmentDesc {
 
 fn one() -> f32 {
     1.0
+}
+
+/// `[[lights]]`: lights that are not shapes. Parameter names follow Mitsuba 3's emitters.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LightDesc {
+    /// Light leaving one point equally in all directions (`point`).
+    Point {
+        /// Where it is.
+        position: [f32; 3],
+        /// Radiant intensity, W/sr (a number or [r, g, b]).
+        intensity: RgbValue,
+    },
+    /// A point light limited to a cone (`spot`).
+    Spot {
+        /// Where it is.
+        position: [f32; 3],
+        /// The cone's axis (or give `target`).
+        direction: Option<[f32; 3]>,
+        /// A point on the cone's axis (or give `direction`).
+        target: Option<[f32; 3]>,
+        /// Radiant intensity on the axis, W/sr.
+        intensity: RgbValue,
+        /// Half-angle in degrees beyond which no light leaves (default 20).
+        cutoff_angle: Option<f32>,
+        /// Half-angle in degrees within which the intensity is full (default 3/4 of the cutoff).
+        beam_width: Option<f32>,
+        /// `mitsuba` (linear in the angle between beam and cutoff; default) or `gltf` (glTF's
+        /// squared ramp in the cosine).
+        falloff: Option<SpotFalloffDesc>,
+    },
+    /// Parallel light from infinitely far away (`directional`).
+    Directional {
+        /// The direction the light travels.
+        direction: [f32; 3],
+        /// Irradiance on a surface facing the light, W/m^2.
+        irradiance: RgbValue,
+    },
+    /// A disc of constant radiance infinitely far away, casting soft shadows.
+    Sun {
+        /// The direction the light travels (from the sun towards the scene).
+        direction: [f32; 3],
+        /// Irradiance on a surface facing the sun, W/m^2.
+        irradiance: RgbValue,
+        /// Angular diameter of the disc in degrees (default 0.533, the sun's as seen from Earth).
+        angular_diameter: Option<f32>,
+    },
+}
+
+/// Spot falloff profiles by the renderer that defines them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpotFalloffDesc {
+    /// Mitsuba 3's `spot`.
+    Mitsuba,
+    /// glTF's `KHR_lights_punctual`.
+    Gltf,
 }
 
 fn unit_scale() -> [f32; 2] {
@@ -418,6 +499,12 @@ pub struct ShapeDesc {
     /// Turn the shape inside out (its front, and the side an emitter lights, become the back).
     #[serde(default)]
     pub flip_normals: bool,
+    /// gltf: whether the file's `KHR_lights_punctual` lights are added to the scene (default
+    /// true).
+    pub lights: Option<bool>,
+    /// gltf: factor from the file's light intensities (candela, lux) to tessera's (W/sr,
+    /// W/m^2); default 1/683, photometric to radiometric at 683 lm/W.
+    pub light_scale: Option<f32>,
 }
 
 /// Kinds of shapes.

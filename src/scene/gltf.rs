@@ -3,11 +3,13 @@
 //! glTF's top-left origin to tessera's bottom-left one (v -> 1 - v, DESIGN.md section 3).
 
 use crate::bsdf::PlasticTables;
+use crate::camera::{FovAxis, Projection};
 use crate::color::Rgb;
 use crate::error::{Error, Result, guard_parser};
 use crate::files::read_bounded;
 use crate::geometry::TriangleMesh;
 use crate::image::{Bitmap, ColorSpace, decode_image as decode_image_bytes};
+use crate::light::{DistantLight, Lights, PointLight, SpotCone, SpotFalloff};
 use crate::limits;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, TextureId};
 use crate::texture::{Channel, Filter, ImageTexture, MipMap, Texture};
@@ -18,9 +20,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// The meshes of a glTF file in world space, each with its material (an index into the scene's
-/// materials) if the primitive has one, and what was ignored.
+/// materials) if the primitive has one, its punctual lights, and what was ignored.
 pub(super) struct GltfImport {
     pub meshes: Vec<(TriangleMesh, Option<u32>)>,
+    pub lights: Lights,
     pub warnings: Vec<String>,
 }
 
@@ -172,30 +175,74 @@ fn walk_nodes(path: &Path, doc: &gltf::Document, mut f: impl FnMut(&gltf::Node, 
     Ok(())
 }
 
-/// The camera-to-world matrix and vertical field of view (degrees) of the `index`-th camera node.
-pub(super) fn import_camera(path: &Path, index: usize) -> Result<(Mat4, f32)> {
+/// The camera-to-world matrix, projection (vertical: `yfov`, or twice `ymag`) and `znear` of the
+/// `index`-th camera node.
+pub(super) fn import_camera(path: &Path, index: usize) -> Result<(Mat4, Projection, f32)> {
     let file = read_gltf(path)?;
-    // Per camera node: its world matrix and vertical field of view (None if orthographic).
-    let mut cameras: Vec<(Mat4, Option<f32>)> = Vec::new();
+    let mut cameras: Vec<(Mat4, Projection, f32)> = Vec::new();
     guard_parser(path, || {
         walk_nodes(path, &file.doc, |node, m| {
             if let Some(cam) = node.camera() {
-                let yfov = match cam.projection() {
-                    gltf::camera::Projection::Perspective(p) => Some(p.yfov().to_degrees()),
-                    gltf::camera::Projection::Orthographic(_) => None,
-                };
-                cameras.push((m, yfov));
+                let axis = FovAxis::Y;
+                cameras.push(match cam.projection() {
+                    gltf::camera::Projection::Perspective(p) => {
+                        (m, Projection::Perspective { fov: p.yfov().to_degrees(), axis }, p.znear())
+                    }
+                    gltf::camera::Projection::Orthographic(o) => {
+                        (m, Projection::Orthographic { extent: 2.0 * o.ymag(), axis }, o.znear())
+                    }
+                });
             }
             Ok(())
         })
     })?;
     let count = cameras.len();
-    let (m, yfov) = cameras
+    cameras
         .into_iter()
         .nth(index)
-        .ok_or_else(|| Error::mesh(path, format!("camera {index} requested, but the file has {count} camera nodes")))?;
-    let yfov = yfov.ok_or_else(|| Error::mesh(path, "orthographic cameras are not supported"))?;
-    Ok((m, yfov))
+        .ok_or_else(|| Error::mesh(path, format!("camera {index} requested, but the file has {count} camera nodes")))
+}
+
+/// Luminous efficacy at which photometric glTF intensities become radiometric ones: 683 lm/W,
+/// that of light at 555 nm, as Blender's glTF importer converts them.
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+/// The `KHR_lights_punctual` lights of the file's default scene, in world space, with
+/// intensities (candela for points and spots, lux for directional lights) multiplied by
+/// `scale`. Spots keep glTF's falloff, and lights with a range glTF's window.
+fn read_lights(path: &Path, file: &GltfFile, scale: f32) -> Result<Lights> {
+    use gltf::khr_lights_punctual::Kind;
+    let mut lights = Lights::default();
+    walk_nodes(path, &file.doc, |node, m| {
+        let Some(light) = node.light() else { return Ok(()) };
+        let bad = |msg: String| Error::mesh(path, format!("light {} (node {}): {msg}", light.index(), node.index()));
+        let intensity = light.intensity() * scale;
+        if !(intensity >= 0.0 && intensity.is_finite()) || light.color().iter().any(|c| !(*c >= 0.0 && c.is_finite())) {
+            let (i, c) = (light.intensity(), light.color());
+            return Err(bad(format!("intensity {i} and colour {c:?} must be finite and >= 0")));
+        }
+        let power = Rgb::from(light.color()) * intensity;
+        let range = match light.range() {
+            Some(r) if !(r > 0.0 && r.is_finite()) => return Err(bad(format!("range {r} must be > 0"))),
+            r => r,
+        };
+        let position = m.transform_point3(Vec3::ZERO);
+        let axis = m.transform_vector3(Vec3::NEG_Z);
+        match light.kind() {
+            Kind::Directional => lights.distant.push(DistantLight::new(axis, power, 0.0).map_err(bad)?),
+            Kind::Point => lights.points.push(PointLight { position, intensity: power, spot: None, range }),
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                if !(outer_cone_angle > 0.0 && outer_cone_angle <= std::f32::consts::FRAC_PI_2) {
+                    return Err(bad(format!("outerConeAngle {outer_cone_angle} is outside (0, pi/2]")));
+                }
+                let cone = SpotCone::new(axis, inner_cone_angle, outer_cone_angle, SpotFalloff::SquaredInCosine)
+                    .map_err(bad)?;
+                lights.points.push(PointLight { position, intensity: power, spot: Some(cone), range });
+            }
+        }
+        Ok(())
+    })?;
+    Ok(lights)
 }
 
 /// A primitive's vertex tangents (glTF TANGENT's xyz), in world space.
@@ -259,14 +306,14 @@ fn check_accessor(file: &GltfFile, accessor: &gltf::Accessor, semantic: Option<&
 }
 
 /// Read every triangle primitive of the default scene in world space, with its material index
-/// and its tangents if it has them. An error for a primitive without positions, with a bad
-/// accessor or index count, more triangles than the limit, or a scene without triangles.
+/// and its tangents if it has them; returns how many it read. An error for a primitive without
+/// positions, with a bad accessor or index count, or more triangles than the limit.
 fn read_primitives(
     path: &Path,
     file: &GltfFile,
     warnings: &mut Vec<String>,
     mut f: impl FnMut(TriangleMesh, Option<usize>, Tangents),
-) -> Result<()> {
+) -> Result<usize> {
     let mut count = 0;
     let mut triangles = 0u64;
     let error = |msg: String| Error::mesh(path, msg);
@@ -334,10 +381,12 @@ fn read_primitives(
         }
         Ok(())
     })?;
-    if count == 0 {
-        return Err(Error::mesh(path, "the file's scene has no triangle meshes"));
-    }
-    Ok(())
+    Ok(count)
+}
+
+/// The error for a file whose scene has nothing tessera can use.
+fn nothing_to_import(path: &Path, what: &str) -> Error {
+    Error::mesh(path, format!("the file's scene has no triangle meshes{what}"))
 }
 
 /// glTF's texture coordinates (origin top-left) as tessera's (origin bottom-left), DESIGN.md
@@ -353,7 +402,7 @@ pub(super) fn import_surface(path: &Path) -> Result<(TriangleMesh, Option<Vec<Ve
     let mut surface = TriangleMesh { uvs: Some(Vec::new()), ..TriangleMesh::default() };
     let mut tangents = Some(Vec::new());
     guard_parser(path, || {
-        read_primitives(path, &file, &mut Vec::new(), |mesh, _, t| {
+        let count = read_primitives(path, &file, &mut Vec::new(), |mesh, _, t| {
             let base = surface.positions.len() as u32;
             match (&mut surface.uvs, mesh.uvs) {
                 (Some(all), Some(uvs)) => all.extend(uvs),
@@ -365,7 +414,11 @@ pub(super) fn import_surface(path: &Path) -> Result<(TriangleMesh, Option<Vec<Ve
             }
             surface.positions.extend(mesh.positions);
             surface.indices.extend(mesh.indices.iter().map(|i| i.map(|v| v + base)));
-        })
+        })?;
+        if count == 0 {
+            return Err(nothing_to_import(path, ""));
+        }
+        Ok(())
     })?;
     Ok((surface, tangents))
 }
@@ -487,12 +540,14 @@ fn convert_material(
 }
 
 /// Load all triangle primitives of the file's default scene, in world space (node transforms
-/// applied), adding the materials and textures they use to the scene's lists.
+/// applied), adding the materials and textures they use to the scene's lists, and its punctual
+/// lights with their intensities times `light_scale` (None: leave the lights out).
 pub(super) fn import_meshes(
     path: &Path,
     textures: &mut Vec<Texture>,
     materials: &mut Vec<Material>,
     pbr_tables: fn() -> Arc<PlasticTables>,
+    light_scale: Option<f32>,
 ) -> Result<GltfImport> {
     let file = read_gltf(path)?;
     guard_parser(path, || {
@@ -507,6 +562,13 @@ pub(super) fn import_meshes(
         read_primitives(path, &file, &mut warnings, |mesh, material, _| {
             meshes.push((mesh, material.map(|i| first_material + i as u32)));
         })?;
-        Ok(GltfImport { meshes, warnings })
+        let lights = match light_scale {
+            Some(scale) => read_lights(path, &file, scale)?,
+            None => Lights::default(),
+        };
+        if meshes.is_empty() && lights.count() == 0 {
+            return Err(nothing_to_import(path, " and no punctual lights"));
+        }
+        Ok(GltfImport { meshes, lights, warnings })
     })
 }

@@ -3,12 +3,13 @@
 
 use super::desc::{
     BlendKind, CameraDesc, ColorValue, DeformationDesc, EnvironmentDesc, FloatValue, IorValue, MaterialDesc,
-    RenderDesc, RgbValue, ScaleValue, SceneDesc, ShapeDesc, ShapeKind, TextureDesc, TilingBlendingDesc, TransformStep,
+    ProjectionKind, RenderDesc, RgbValue, ScaleValue, SceneDesc, ShapeDesc, ShapeKind, TextureDesc, TilingBlendingDesc,
+    TransformStep,
 };
 use super::{Geometry, RenderSettings, Scene};
 use crate::accel::Accel;
 use crate::bsdf::PlasticTables;
-use crate::camera::{FovAxis, PerspectiveCamera};
+use crate::camera::{Camera, CameraModel, FovAxis, Projection, ThinLens};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::read_text_bounded;
@@ -208,7 +209,8 @@ impl<'a> Loader<'a> {
                 Some(RgbValue(e)) if e.iter().any(|v| *v > 0.0) => Some(Rgb::from(e)),
                 _ => None,
             };
-            for (mesh, material) in self.shape_meshes(shape, &item, &mut materials)? {
+            let mut file_lights = Lights::default();
+            for (mesh, material) in self.shape_meshes(shape, &item, &mut materials, &mut file_lights)? {
                 let mut mesh = mesh;
                 mesh.transform(&transform);
                 if shape.flip_normals {
@@ -241,24 +243,27 @@ impl<'a> Loader<'a> {
                 });
                 geometry.add(mesh, item.clone(), material, light);
             }
+            lights.points.extend(file_lights.points.iter().map(|l| l.transformed(&transform)));
+            for l in &file_lights.distant {
+                lights.distant.push(l.transformed(&transform).map_err(|msg| self.error(format!("{item}: {msg}")))?);
+            }
         }
 
         lights.environment = match &desc.environment {
             Some(env) => Some(self.environment(env)?),
             None => None,
         };
+        for (i, light) in desc.lights.iter().enumerate() {
+            super::lights::add_light(&mut lights, light, MAX_RADIANCE)
+                .map_err(|msg| self.error(format!("lights[{i}]: {msg}")))?;
+        }
         if geometry.shapes.is_empty() {
             self.warnings
                 .push(format!("{}: the scene has no shapes: only the environment is seen", self.path.display()));
         }
-        let environment_emits = match &lights.environment {
-            None => false,
-            Some(Environment::Constant(c)) => c.max_element() > 0.0,
-            Some(Environment::Map(_)) => true,
-        };
-        if lights.area.is_empty() && !environment_emits {
+        if !lights.any_emit() {
             self.warnings.push(format!(
-                "{}: the scene has no light (no emission, no environment): the image will be black",
+                "{}: the scene has no light (no emission, no lights, no environment): the image will be black",
                 self.path.display()
             ));
         }
@@ -974,12 +979,14 @@ impl<'a> Loader<'a> {
         Ok(m)
     }
 
-    /// The meshes of a shape, each with the material it brings (glTF) if any.
+    /// The meshes of a shape, each with the material it brings (glTF) if any; a glTF file's
+    /// punctual lights are added to `file_lights`, in the file's space.
     fn shape_meshes(
         &mut self,
         shape: &ShapeDesc,
         item: &str,
         materials: &mut Vec<Material>,
+        file_lights: &mut Lights,
     ) -> Result<Vec<(TriangleMesh, Option<u32>)>> {
         let needs_file = matches!(shape.kind, ShapeKind::Obj | ShapeKind::Gltf);
         if needs_file != shape.filename.is_some() {
@@ -992,6 +999,9 @@ impl<'a> Loader<'a> {
         if shape.kind != ShapeKind::UvSphere && (shape.segments.is_some() || shape.rings.is_some()) {
             return Err(self.error(format!("{item}: segments and rings apply to uv_sphere only")));
         }
+        if shape.kind != ShapeKind::Gltf && (shape.lights.is_some() || shape.light_scale.is_some()) {
+            return Err(self.error(format!("{item}: lights and light_scale apply to gltf shapes only")));
+        }
         Ok(match shape.kind {
             ShapeKind::Obj => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
@@ -999,8 +1009,14 @@ impl<'a> Loader<'a> {
             }
             ShapeKind::Gltf => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
-                let import = super::gltf::import_meshes(&file, &mut self.textures, materials, pbr_tables)
+                let scale = shape.light_scale.unwrap_or(1.0 / super::gltf::LUMENS_PER_WATT);
+                if !(0.0..=MAX_RADIANCE).contains(&scale) {
+                    return Err(self.error(format!("{item}.light_scale: {scale} is outside [0, {MAX_RADIANCE:e}]")));
+                }
+                let light_scale = shape.lights.unwrap_or(true).then_some(scale);
+                let import = super::gltf::import_meshes(&file, &mut self.textures, materials, pbr_tables, light_scale)
                     .map_err(|e| e.in_scene(self.path, item))?;
+                *file_lights = import.lights;
                 self.warnings
                     .extend(import.warnings.into_iter().map(|w| format!("{}: {item}: {w}", self.path.display())));
                 import.meshes
@@ -1045,7 +1061,7 @@ impl<'a> Loader<'a> {
         })
     }
 
-    fn camera(&self, c: &CameraDesc, s: &RenderSettings) -> Result<PerspectiveCamera> {
+    fn camera(&self, c: &CameraDesc, s: &RenderSettings) -> Result<Camera> {
         let placed_by = [c.eye.is_some() || c.target.is_some(), c.matrix.is_some(), c.gltf.is_some()];
         if placed_by.iter().filter(|p| **p).count() != 1 {
             return Err(self.error("camera: place it with exactly one of eye/target, matrix or gltf"));
@@ -1053,11 +1069,11 @@ impl<'a> Loader<'a> {
         if c.index.is_some() && c.gltf.is_none() {
             return Err(self.error("camera.index applies to a gltf camera only"));
         }
-        let (to_world, gltf_fov) = if let Some(file) = &c.gltf {
+        let (to_world, from_file) = if let Some(file) = &c.gltf {
             let path = self.resolve_path(file);
-            let (m, yfov) =
+            let (m, projection, znear) =
                 super::gltf::import_camera(&path, c.index.unwrap_or(0)).map_err(|e| e.in_scene(self.path, "camera"))?;
-            (m, Some(yfov))
+            (m, Some((projection, znear)))
         } else if let Some(m) = c.matrix {
             (Mat4::from_cols_array(&m).transpose(), None)
         } else {
@@ -1066,18 +1082,51 @@ impl<'a> Loader<'a> {
             };
             let up = Vec3::from(c.up.unwrap_or([0.0, 1.0, 0.0]));
             (
-                PerspectiveCamera::look_at(Vec3::from(eye), Vec3::from(target), up)
+                Camera::look_at(Vec3::from(eye), Vec3::from(target), up)
                     .map_err(|e| e.in_scene(self.path, "camera"))?,
                 None,
             )
         };
-        let (fov, axis) = match (c.fov, gltf_fov) {
-            (Some(f), _) => (f, c.fov_axis.unwrap_or(FovAxis::Y)),
-            (None, Some(y)) => (y, FovAxis::Y),
-            (None, None) => return Err(self.error("camera.fov is required (degrees)")),
+        let file_projection = from_file.map(|(p, _)| p);
+        let kind = c.projection.unwrap_or(match file_projection {
+            Some(Projection::Orthographic { .. }) => ProjectionKind::Orthographic,
+            _ => ProjectionKind::Perspective,
+        });
+        let axis = c.fov_axis.unwrap_or(FovAxis::Y);
+        let projection = match kind {
+            ProjectionKind::Perspective => {
+                if c.extent.is_some() {
+                    return Err(self.error("camera.extent applies to an orthographic camera (use fov)"));
+                }
+                match (c.fov, file_projection) {
+                    (Some(fov), _) => Projection::Perspective { fov, axis },
+                    (None, Some(p @ Projection::Perspective { .. })) => p,
+                    _ => return Err(self.error("camera.fov is required (degrees)")),
+                }
+            }
+            ProjectionKind::Orthographic => {
+                if c.fov.is_some() {
+                    return Err(self.error("camera.fov applies to a perspective camera (use extent)"));
+                }
+                match (c.extent, file_projection) {
+                    (Some(extent), _) => Projection::Orthographic { extent, axis },
+                    (None, Some(p @ Projection::Orthographic { .. })) => p,
+                    _ => {
+                        return Err(self.error(
+                            "camera.extent is required for an orthographic camera (the image's size in world units along fov_axis)",
+                        ));
+                    }
+                }
+            }
         };
-        PerspectiveCamera::new(to_world, fov, axis, s.width, s.height, s.spp)
-            .map_err(|e| e.in_scene(self.path, "camera"))
+        let lens = match (c.aperture_radius, c.focus_distance) {
+            (Some(aperture_radius), Some(focus_distance)) => Some(ThinLens { aperture_radius, focus_distance }),
+            (None, None) => None,
+            _ => return Err(self.error("camera: a thin lens needs both aperture_radius and focus_distance")),
+        };
+        let near_clip = c.near_clip.or(from_file.map(|(_, znear)| znear)).unwrap_or(0.0);
+        let model = CameraModel { projection, lens, near_clip };
+        Camera::new(to_world, model, s.width, s.height, s.spp).map_err(|e| e.in_scene(self.path, "camera"))
     }
 }
 

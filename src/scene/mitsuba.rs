@@ -24,12 +24,13 @@
 //! warning.
 
 use super::Scene;
-use crate::camera::FovAxis;
+use crate::camera::{FovAxis, Projection};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::StagedFolder;
+use crate::geometry::Frame;
 use crate::image::write_exr;
-use crate::light::Environment;
+use crate::light::{Environment, SpotFalloff};
 use crate::limits;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
 use crate::texture::{BakeFootprint, Channel, Filter, Texture, bake};
@@ -311,28 +312,125 @@ impl Exporter<'_> {
         Ok(file)
     }
 
+    /// The camera as Mitsuba's `perspective`, `thinlens` or `orthographic` sensor.
     fn sensor(&self) -> String {
         let s = &self.scene.settings;
         let camera = &self.scene.camera;
-        let (fov, axis) = camera.fov();
+        let model = camera.model();
         // tessera's camera looks down -z with x right; Mitsuba's looks down +z with x left.
-        let m = camera.to_world() * Mat4::from_scale(glam::Vec3::new(-1.0, 1.0, -1.0));
+        let mut m = camera.to_world() * Mat4::from_scale(Vec3::new(-1.0, 1.0, -1.0));
+        let axis_name = |axis: FovAxis| if axis == FovAxis::X { "x" } else { "y" };
+        // Mitsuba needs a near clip > 0; tessera's default 0 becomes a millimetre.
+        let near_clip = if model.near_clip > 0.0 { model.near_clip } else { 0.001 };
+        let (kind, params) = match (model.projection, model.lens) {
+            (Projection::Perspective { fov, axis }, lens) => {
+                let mut params = format!(
+                    "<float name=\"fov\" value=\"{fov}\"/><string name=\"fov_axis\" value=\"{}\"/>",
+                    axis_name(axis)
+                );
+                let kind = match lens {
+                    None => "perspective",
+                    Some(lens) => {
+                        let _ = write!(
+                            params,
+                            "<float name=\"aperture_radius\" value=\"{}\"/><float name=\"focus_distance\" value=\"{}\"/>",
+                            lens.aperture_radius, lens.focus_distance
+                        );
+                        "thinlens"
+                    }
+                };
+                (kind, params)
+            }
+            (Projection::Orthographic { extent, axis }, _) => {
+                // Mitsuba's film spans x in [-1, 1] (y by the aspect ratio) before to_world.
+                let (w, h) = (s.width as f32, s.height as f32);
+                let half_x = if axis == FovAxis::X { 0.5 * extent } else { 0.5 * extent * w / h };
+                m *= Mat4::from_scale(Vec3::new(half_x, half_x, 1.0));
+                ("orthographic", String::new())
+            }
+        };
         let rows = m.transpose().to_cols_array().map(|v| v.to_string()).join(" ");
         format!(
-            "<sensor type=\"perspective\">\
-             <float name=\"fov\" value=\"{fov}\"/><string name=\"fov_axis\" value=\"{}\"/>\
-             <float name=\"near_clip\" value=\"0.001\"/><float name=\"far_clip\" value=\"10000000\"/>\
+            "<sensor type=\"{kind}\">{params}\
+             <float name=\"near_clip\" value=\"{near_clip}\"/><float name=\"far_clip\" value=\"10000000\"/>\
              <transform name=\"to_world\"><matrix value=\"{rows}\"/></transform>\
              <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{}\"/><integer name=\"seed\" value=\"{}\"/></sampler>\
              <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/>\
              <string name=\"pixel_format\" value=\"rgb\"/><string name=\"component_format\" value=\"float32\"/>\
              <rfilter type=\"box\"/></film></sensor>",
-            if axis == FovAxis::X { "x" } else { "y" },
-            s.spp,
-            s.seed,
-            s.width,
-            s.height
+            s.spp, s.seed, s.width, s.height
         )
+    }
+
+    /// Point, spot, directional lights and suns as Mitsuba's `point`, `spot` and `directional`
+    /// emitters; what Mitsuba lacks (glTF's spot falloff and range window, the sun's disc) is
+    /// exported as the nearest emitter, with a warning.
+    fn punctual_emitters(&mut self) -> String {
+        let lights = &self.scene.lights;
+        let mut xml = String::new();
+        for (i, light) in lights.points.iter().enumerate() {
+            let p = light.position;
+            let intensity = rgb_value(light.intensity);
+            if light.range.is_some() {
+                self.out.warnings.push(format!(
+                    "point light {i}: glTF's range window has no Mitsuba equivalent: exported without it"
+                ));
+            }
+            let Some(cone) = &light.spot else {
+                let _ = write!(
+                    xml,
+                    "<emitter type=\"point\"><point name=\"position\" value=\"{}, {}, {}\"/>\
+                     <rgb name=\"intensity\" value=\"{intensity}\"/></emitter>",
+                    p.x, p.y, p.z
+                );
+                continue;
+            };
+            if cone.falloff() != SpotFalloff::LinearInAngle {
+                self.out.warnings.push(format!(
+                    "point light {i}: glTF's spot falloff (squared in the cosine) exported as Mitsuba's (linear in the angle)"
+                ));
+            }
+            let (beam, cutoff) = cone.angles();
+            let target = p + cone.axis();
+            let up = Frame::from_normal(cone.axis()).s;
+            let _ = write!(
+                xml,
+                "<emitter type=\"spot\"><transform name=\"to_world\"><lookat origin=\"{}, {}, {}\" \
+                 target=\"{}, {}, {}\" up=\"{}, {}, {}\"/></transform><rgb name=\"intensity\" value=\"{intensity}\"/>\
+                 <float name=\"cutoff_angle\" value=\"{}\"/><float name=\"beam_width\" value=\"{}\"/></emitter>",
+                p.x,
+                p.y,
+                p.z,
+                target.x,
+                target.y,
+                target.z,
+                up.x,
+                up.y,
+                up.z,
+                cutoff.to_degrees(),
+                beam.to_degrees()
+            );
+        }
+        for (i, light) in lights.distant.iter().enumerate() {
+            if !light.is_delta() {
+                self.out.warnings.push(format!(
+                    "distant light {i}: Mitsuba has no sun disc: exported as a directional light with the same \
+                     irradiance (hard shadows instead of a {:.3}-degree penumbra)",
+                    light.angular_diameter().to_degrees()
+                ));
+            }
+            let d = light.direction();
+            let _ = write!(
+                xml,
+                "<emitter type=\"directional\"><vector name=\"direction\" value=\"{}, {}, {}\"/>\
+                 <rgb name=\"irradiance\" value=\"{}\"/></emitter>",
+                d.x,
+                d.y,
+                d.z,
+                rgb_value(light.irradiance())
+            );
+        }
+        xml
     }
 
     fn environment(&mut self) -> Result<String> {
@@ -398,8 +496,9 @@ pub fn export_mitsuba(scene: &Scene, dir: &Path, bake_res: usize) -> Result<Mits
             shape.material
         );
     }
+    let punctual = ex.punctual_emitters();
     let env = ex.environment()?;
-    let _ = writeln!(xml, "{env}\n</scene>");
+    let _ = writeln!(xml, "{punctual}{env}\n</scene>");
     ex.write_text("scene.xml", &xml)?;
     let mut out = ex.out;
     out.warnings.sort();

@@ -3,6 +3,7 @@
 
 pub mod desc;
 mod gltf;
+mod lights;
 mod load;
 mod mitsuba;
 mod set;
@@ -26,7 +27,7 @@ pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Opti
 }
 
 use crate::accel::{Accel, Hit};
-use crate::camera::PerspectiveCamera;
+use crate::camera::Camera;
 use crate::geometry::{Bounds, Ray, SurfaceInteraction, TriangleMesh, TriangleVertices};
 use crate::light::Lights;
 use crate::material::Material;
@@ -146,7 +147,7 @@ pub struct Scene {
     /// Image and integrator settings.
     pub settings: RenderSettings,
     /// The camera.
-    pub camera: PerspectiveCamera,
+    pub camera: Camera,
     /// Triangles and shapes.
     pub geometry: Geometry,
     /// Ray intersection over `geometry`.
