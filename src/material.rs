@@ -144,6 +144,9 @@ pub enum MaterialKind {
 /// A material: a scattering model, an optional tangent-space normal map, and sidedness.
 #[derive(Clone, Debug)]
 pub struct Material {
+    /// What the scene calls it, for messages: `materials.NAME`, a glTF file's material, or
+    /// the default.
+    pub name: String,
     /// Model and parameters.
     pub kind: MaterialKind,
     /// Tangent-space normal map (RGB in [0, 1] encodes n = 2 rgb - 1 in the shading frame).
@@ -179,7 +182,9 @@ impl Material {
     /// diffuse with reflectance 0.5, or 0 (black) if the shape is an emitter.
     pub fn default_diffuse(emitter: bool) -> Self {
         let reflectance = ColorParam::Value(Rgb::splat(if emitter { 0.0 } else { 0.5 }));
+        let name = if emitter { "the default emitter material (black)" } else { "the default material (diffuse 0.5)" };
         Material {
+            name: name.to_string(),
             kind: MaterialKind::Diffuse { reflectance },
             normal_map: None,
             two_sided: false,

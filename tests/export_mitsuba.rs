@@ -201,12 +201,31 @@ fn cameras_and_punctual_lights_export_as_their_mitsuba_plugins() {
 #[test]
 fn pbr_materials_are_not_exported_silently() {
     let dir = common::scene_dir(
-        "[camera]\nfov = 30\neye = [0, 0, 4]\ntarget = [0, 0, 0]\n[materials.gold]\ntype = \"pbr\"\n[[shapes]]\ntype = \"cube\"\nmaterial = \"gold\"\n",
+        "[camera]\nfov = 30\neye = [0, 0, 4]\ntarget = [0, 0, 0]\n[materials.gold]\ntype = \"pbr\"\n\
+         base_color = [1, 0.8, 0.3]\nmetallic = 0.7\nroughness = 0.5\nanisotropy = 0.5\n\
+         [[shapes]]\ntype = \"cube\"\nmaterial = \"gold\"\n",
         &[],
     );
     let scene = common::load(dir.path()).unwrap();
-    let err = export_mitsuba(&scene, &dir.path().join("out"), 256).unwrap_err().to_string();
-    assert!(err.contains("material 0") && err.contains("no exact Mitsuba 3 equivalent"), "{err}");
+    let report = export_mitsuba(&scene, &dir.path().join("out"), 256).unwrap();
+    // Warnings name the material as the scene does.
+    let warnings = report.warnings.join("\n");
+    assert!(warnings.contains("materials.gold: glTF's metallic-roughness has no exact Mitsuba 3 equivalent"));
+    assert!(warnings.contains("materials.gold: its anisotropy is not exported"), "{warnings}");
+    let xml = std::fs::read_to_string(dir.path().join("out/scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let blend = doc.descendants().find(|n| n.attribute("type") == Some("blendbsdf")).expect("a blendbsdf");
+    assert_eq!(attr(blend, "weight"), Some("0.7"));
+    let lobes: Vec<_> = blend.children().filter(|n| n.has_tag_name("bsdf")).collect();
+    assert_eq!(
+        lobes.iter().map(|n| n.attribute("type").unwrap()).collect::<Vec<_>>(),
+        ["roughplastic", "roughconductor"]
+    );
+    // alpha = roughness^2 in both lobes; the metal's F0 is the base colour: eta of F0 = 1 is huge.
+    assert_eq!(attr(lobes[0], "alpha"), Some("0.25"));
+    let eta: Vec<f32> = attr(lobes[1], "eta").unwrap().split(',').map(|v| v.trim().parse().unwrap()).collect();
+    let f0 = |eta: f32| ((eta - 1.0) / (eta + 1.0)).powi(2);
+    assert!((f0(eta[1]) - 0.8).abs() < 1e-4 && (f0(eta[2]) - 0.3).abs() < 1e-4, "{eta:?}");
 }
 
 #[test]

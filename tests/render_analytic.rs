@@ -75,31 +75,11 @@ fn square_light_over_diffuse_floor_matches_form_factor() {
     let s = (1.0 + x * x).sqrt();
     let form_factor = 4.0 / (2.0 * std::f64::consts::PI) * (2.0 * x / s * (x / s).atan());
     let (rho, le) = (0.5, 3.0);
-    let toml = format!(
-        r#"
-        [render]
-        width = 8
-        height = 8
-        spp = 512
-        max_depth = 2
-        [camera]
-        fov = 1
-        eye = [0, 0.5, 0]
-        target = [0, 0, 0]
-        up = [0, 0, -1]
-        [materials.floor]
-        type = "diffuse"
-        reflectance = {rho}
-        [[shapes]]
-        type = "rectangle"
-        material = "floor"
-        transform = [{{ scale = 10 }}, {{ rotate = [1, 0, 0], angle = -90 }}]
-        [[shapes]]
-        type = "rectangle"
-        emission = {le}
-        transform = [{{ rotate = [1, 0, 0], angle = 90 }}, {{ translate = [0, 1, 0] }}]
-        "#
+    let light = format!(
+        "[[shapes]]\ntype = \"rectangle\"\nemission = {le}\n\
+         transform = [{{ rotate = [1, 0, 0], angle = 90 }}, {{ translate = [0, 1, 0] }}]"
     );
+    let toml = lit_floor(rho, "", &light);
     assert_mean(&toml, &[], rho * le * form_factor, 1e-4, "floor under a square light");
 }
 

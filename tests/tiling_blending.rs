@@ -447,6 +447,7 @@ fn deformation_orients_the_shading_frame_along_the_texture() {
             vec![tb(&synthesis(Tiling::Hexagonal, Blend::Linear, Some(vec![Deformation::Constant(f)])), &exemplar)];
         let alpha = FloatParam::Texture { id: TextureId(0), channel: tessera::texture::Channel::R, scale: 1.0 };
         let material = Material {
+            name: "test".into(),
             kind: MaterialKind::Conductor {
                 roughness: Some(Roughness { alpha_u: alpha, alpha_v: FloatParam::Value(0.05) }),
                 eta: Rgb::ZERO,

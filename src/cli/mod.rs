@@ -174,6 +174,15 @@ enum Command {
         #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=limits::MAX_BAKE_RES as i64))]
         bake_res: u32,
     },
+    /// Translate a Mitsuba 3 XML scene into a tessera scene file, listing what was not
+    /// translated exactly (on stderr and in the file's header).
+    ImportMitsuba {
+        /// Mitsuba scene (XML).
+        scene: PathBuf,
+        /// The scene file to write (TOML); its file names are relative to its folder.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Evaluate one texture of a scene over the UV square [0, 1]^2, with no light transport
     /// (EXR: linear RGBA; PNG: sRGB RGB). Row 0 is the top (v = 1).
     Bake {
@@ -371,6 +380,26 @@ pub fn run() -> Result<ExitCode> {
                 eprintln!("warning: {w}");
             }
             eprintln!("{}: wrote {} files to {}", scene.path.display(), export.files.len(), output.display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::ImportMitsuba { scene, output } => {
+            let out_dir = output.parent().map(Path::to_path_buf).unwrap_or_default();
+            let import = tessera::scene::import_mitsuba(&scene, &out_dir)?;
+            let text = import.to_toml(&scene);
+            // The scene must load (its files found, its values valid) before it replaces a file.
+            tessera::files::write_atomically(&output, |tmp| {
+                std::fs::write(tmp, &text).map_err(|e| Error::io(tmp, e))?;
+                tessera::scene::load_scene(tmp, &SceneOverrides::default()).map(drop)
+            })?;
+            for line in &import.untranslated {
+                eprintln!("warning: not translated exactly: {line}");
+            }
+            eprintln!(
+                "{}: wrote {} ({} items not translated exactly)",
+                scene.display(),
+                output.display(),
+                import.untranslated.len()
+            );
             Ok(ExitCode::SUCCESS)
         }
         Command::Bake { scene, texture, res, output, data, footprint, gpu } => {

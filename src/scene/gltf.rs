@@ -523,7 +523,10 @@ fn convert_material(
     if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
         warnings.push(format!("material '{name}': alpha mode {:?} ignored (rendered opaque)", m.alpha_mode()));
     }
+    let file_name =
+        cache.path.file_name().map_or_else(|| cache.path.display().to_string(), |f| f.to_string_lossy().into());
     Ok(Material {
+        name: format!("{file_name} material {} '{name}'", m.index().map_or("default".into(), |i| i.to_string())),
         kind: MaterialKind::Pbr {
             base_color,
             metallic,

@@ -920,7 +920,7 @@ impl<'a> Loader<'a> {
             }
         };
         let normal_map = self.normal_map(normal_map, item)?;
-        let mut material = Material { kind, normal_map, two_sided, texture_frame: None };
+        let mut material = Material { name: item.to_string(), kind, normal_map, two_sided, texture_frame: None };
         material.texture_frame = self.texture_frame(&material, item)?;
         Ok(material)
     }
@@ -1131,7 +1131,7 @@ impl<'a> Loader<'a> {
 }
 
 /// Mitsuba's `lookat` transform: local +z towards `target`, local x = normalize(up x z).
-fn mitsuba_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
+pub(super) fn mitsuba_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Mat4> {
     let dir = (target - origin).try_normalize()?;
     let left = up.cross(dir).try_normalize()?;
     let new_up = dir.cross(left);

@@ -12,12 +12,14 @@
 //! - materials as the Mitsuba plugins they mirror (`diffuse`, `conductor` / `roughconductor`,
 //!   `dielectric` / `roughdielectric`, `roughplastic`, all GGX with visible-normal sampling),
 //!   wrapped in `normalmap` and `twosided` where needed;
-//! - the camera as a `perspective` sensor with tessera's camera-to-world matrix turned into
-//!   Mitsuba's camera frame (x left, z forward), a box reconstruction filter, the `path`
-//!   integrator with the same `max_depth` and `rr_depth`.
+//! - the camera as a `perspective`, `thinlens` or `orthographic` sensor with tessera's
+//!   camera-to-world matrix turned into Mitsuba's camera frame (x left, z forward), a box
+//!   reconstruction filter, the `path` integrator with the same `max_depth` and `rr_depth`;
+//! - lights as `area`, `point`, `spot`, `directional`, `constant` and `envmap` emitters.
 //!
-//! Not exportable, and reported as an error: the `pbr` material (no Mitsuba plugin has its
-//! Schlick-Fresnel metal blend). Filtered textures (`trilinear`, `ewa`) are exported bilinear,
+//! Exported as the nearest Mitsuba equivalent, with a warning naming the item: the `pbr`
+//! material (no Mitsuba plugin has its Schlick-Fresnel metal blend; see [`Exporter::pbr`]),
+//! glTF's spot falloff and range window, and the sun's disc. Filtered textures (`trilinear`, `ewa`) are exported bilinear,
 //! with a warning: Mitsuba 3.9 has no MIP-mapping. Procedural textures (tiling and blending)
 //! are baked over the UV square at the export's resolution, with a warning; a shading frame
 //! turned by a deformation field has no Mitsuba equivalent and is exported unturned, with a
@@ -212,12 +214,63 @@ impl Exporter<'_> {
         ))
     }
 
+    /// The glTF metallic-roughness material `name` as the nearest Mitsuba 3 BSDF, with a warning:
+    /// a `blendbsdf` by `metallic` of a `roughplastic` (the dielectric lobe, exact: the same
+    /// model) and a `roughconductor` whose Fresnel has the base colour as F0 (k = 0 and
+    /// eta = (1 + sqrt F0) / (1 - sqrt F0), instead of Schlick's curve, which no Mitsuba plugin
+    /// has; a textured base colour becomes the conductor's `specular_reflectance` over a
+    /// perfect mirror). A textured roughness is exported as its factor.
+    fn pbr(
+        &mut self,
+        name: &str,
+        base_color: &ColorParam,
+        metallic: &FloatParam,
+        roughness: &FloatParam,
+        ior: f32,
+    ) -> Result<String> {
+        self.out.warnings.push(format!(
+            "{name}: glTF's metallic-roughness has no exact Mitsuba 3 equivalent: exported as a blendbsdf of \
+             roughplastic and roughconductor, the metal's Schlick Fresnel replaced by a conductor's of the same F0"
+        ));
+        let r = match *roughness {
+            FloatParam::Value(r) => r,
+            FloatParam::Texture { scale, .. } => {
+                self.out.warnings.push(format!("{name}: its roughness texture is exported as its factor {scale}"));
+                scale
+            }
+        };
+        let alpha = r * r;
+        let plastic = format!(
+            "<bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"ggx\"/>\
+             <boolean name=\"sample_visible\" value=\"true\"/><float name=\"alpha\" value=\"{alpha}\"/>\
+             <float name=\"int_ior\" value=\"{ior}\"/><float name=\"ext_ior\" value=\"1\"/>\
+             <boolean name=\"nonlinear\" value=\"false\"/>{}</bsdf>",
+            self.color(base_color, "diffuse_reflectance")?
+        );
+        let fresnel = match *base_color {
+            ColorParam::Value(f0) => {
+                let root = f0.max(Rgb::ZERO).powf(0.5).min(Rgb::splat(0.999));
+                let eta = (Rgb::ONE + root) / (Rgb::ONE - root);
+                format!("<rgb name=\"eta\" value=\"{}\"/><rgb name=\"k\" value=\"0, 0, 0\"/>", rgb_value(eta))
+            }
+            ColorParam::Texture { .. } => {
+                format!("<string name=\"material\" value=\"none\"/>{}", self.color(base_color, "specular_reflectance")?)
+            }
+        };
+        let metal = format!(
+            "<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"ggx\"/>\
+             <boolean name=\"sample_visible\" value=\"true\"/><float name=\"alpha\" value=\"{alpha}\"/>{fresnel}</bsdf>"
+        );
+        Ok(format!("<bsdf type=\"blendbsdf\">{}{plastic}{metal}</bsdf>", self.float(metallic, "weight")?))
+    }
+
     /// The `<bsdf>` element of material `index`, with its id.
     fn material(&mut self, index: usize, m: &Material) -> Result<String> {
         if m.texture_frame.is_some() {
             self.out.warnings.push(format!(
-                "material {index}: its shading frame follows a deformation field; Mitsuba's follows dp/du, so \
-                 anisotropic roughness and normal maps are exported unturned"
+                "{}: its shading frame follows a deformation field; Mitsuba's follows dp/du, so \
+                 anisotropic roughness and normal maps are exported unturned",
+                m.name
             ));
         }
         let inner = match &m.kind {
@@ -258,11 +311,22 @@ impl Exporter<'_> {
                 self.color(diffuse_reflectance, "diffuse_reflectance")?,
                 self.optional_color(specular_reflectance, "specular_reflectance")?
             ),
-            MaterialKind::Pbr { .. } => {
-                return Err(Error::param(
-                    format!("material {index}"),
-                    "the glTF metallic-roughness (pbr) model has no exact Mitsuba 3 equivalent; export needs diffuse, conductor, dielectric or plastic materials",
-                ));
+            MaterialKind::Pbr {
+                base_color,
+                metallic,
+                roughness,
+                occlusion,
+                anisotropy,
+                anisotropy_direction,
+                tables,
+            } => {
+                if *occlusion != FloatParam::Value(1.0) {
+                    self.out.warnings.push(format!("{}: its occlusion map is not exported", m.name));
+                }
+                if *anisotropy != FloatParam::Value(0.0) || anisotropy_direction.is_some() {
+                    self.out.warnings.push(format!("{}: its anisotropy is not exported (isotropic)", m.name));
+                }
+                self.pbr(&m.name, base_color, metallic, roughness, tables.eta())?
             }
         };
         let mut bsdf = inner;

@@ -6,10 +6,12 @@ mod gltf;
 mod lights;
 mod load;
 mod mitsuba;
+mod mitsuba_import;
 mod set;
 
 pub use load::{SceneOverrides, load_scene, load_scene_str, load_texture};
 pub use mitsuba::{MitsubaExport, export_mitsuba};
+pub use mitsuba_import::{MitsubaImport, import_mitsuba};
 
 /// One mesh file's surface, by extension: OBJ (no tangents), or glTF 2.0 (.gltf, .glb: every
 /// triangle primitive in world space, with per-vertex tangents where every primitive has
