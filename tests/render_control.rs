@@ -176,3 +176,47 @@ fn png_output_is_exposed_and_tone_mapped_and_exr_stays_linear() {
         }
     }
 }
+
+/// PFM and Radiance HDR outputs hold the linear radiance: the PFM bit for bit (read back here
+/// by hand: header, then little-endian rows from the bottom up), the HDR within its RGBE
+/// precision (8-bit mantissas under the exponent of the pixel's largest channel: one step is at
+/// most 1/128 of that channel).
+#[test]
+fn pfm_and_hdr_outputs_hold_the_linear_radiance() {
+    let dir = common::scene_dir(SCENE, &[]);
+    for out in ["a.exr", "a.pfm", "a.hdr"] {
+        let run = Command::new(env!("CARGO_BIN_EXE_tessera"))
+            .arg("render")
+            .arg(dir.path().join("scene.toml"))
+            .args(["-q", "-o"])
+            .arg(dir.path().join(out))
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{out}: {}", String::from_utf8_lossy(&run.stderr));
+    }
+    let exr = tessera::image::read_bitmap_raw(&dir.path().join("a.exr"), tessera::image::ColorSpace::Linear).unwrap();
+    let pfm = std::fs::read(dir.path().join("a.pfm")).unwrap();
+    let header = b"PF\n24 18\n-1.0\n";
+    assert_eq!(&pfm[..header.len()], header);
+    let values: Vec<f32> =
+        pfm[header.len()..].chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect();
+    let (w, h) = (24, 18);
+    assert_eq!(values.len(), w * h * 3);
+    for y in 0..h {
+        for x in 0..w {
+            for c in 0..3 {
+                let from_pfm = values[((h - 1 - y) * w + x) * 3 + c];
+                assert_eq!(from_pfm.to_bits(), exr.data[(y * w + x) * exr.channels + c].to_bits(), "({x}, {y}) {c}");
+            }
+        }
+    }
+    let hdr = tessera::image::read_bitmap_raw(&dir.path().join("a.hdr"), tessera::image::ColorSpace::Linear).unwrap();
+    assert_eq!((hdr.width, hdr.height), (w, h));
+    for i in 0..w * h {
+        let largest = (0..3).map(|c| exr.data[i * exr.channels + c]).fold(0.0, f32::max);
+        for c in 0..3 {
+            let (a, b) = (hdr.data[i * hdr.channels + c], exr.data[i * exr.channels + c]);
+            assert!((a - b).abs() <= largest / 128.0, "pixel {i} channel {c}: {a} vs {b}");
+        }
+    }
+}

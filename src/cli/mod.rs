@@ -30,7 +30,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene to an image (EXR: linear float; PNG: 8-bit sRGB).
+    /// Render a scene to an image (EXR, PFM, HDR: linear float; PNG: 8-bit sRGB).
     Render {
         /// Scene file (TOML).
         scene: PathBuf,
@@ -700,13 +700,13 @@ fn write_film(
     display: (tessera::image::ToneMap, f32),
 ) -> Result<()> {
     use tessera::image::OutputFormat;
-    let (radiance, extra) = match OutputFormat::from_path(output)? {
-        OutputFormat::Png => {
-            if !film.aovs().is_empty() || variance {
-                eprintln!("warning: AOVs are written to EXR outputs only");
-            }
-            (display.0.apply(&film.radiance(), display.1), Vec::new())
-        }
+    let format = OutputFormat::from_path(output)?;
+    if format != OutputFormat::Exr && (!film.aovs().is_empty() || variance) {
+        eprintln!("warning: AOVs are written to EXR outputs only");
+    }
+    let (radiance, extra) = match format {
+        OutputFormat::Png => (display.0.apply(&film.radiance(), display.1), Vec::new()),
+        OutputFormat::Pfm | OutputFormat::Hdr => (film.radiance(), Vec::new()),
         OutputFormat::Exr => {
             let mut extra: Vec<(&[&str], tessera::image::Bitmap)> =
                 film.aovs().iter().filter_map(|a| film.aov(*a).map(|b| (a.channel_names(), b))).collect();

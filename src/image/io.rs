@@ -17,6 +17,10 @@ pub enum OutputFormat {
     Exr,
     /// PNG, 8-bit sRGB, clamped to [0, 1].
     Png,
+    /// Portable float map: RGB 32-bit float, linear, no extra channels.
+    Pfm,
+    /// Radiance HDR (RGBE: an 8-bit mantissa per channel and a shared exponent), linear.
+    Hdr,
 }
 
 impl OutputFormat {
@@ -25,7 +29,9 @@ impl OutputFormat {
         match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
             Some("exr") => Ok(OutputFormat::Exr),
             Some("png") => Ok(OutputFormat::Png),
-            _ => Err(Error::image(path, "the output must end in .exr (linear) or .png (sRGB)")),
+            Some("pfm") => Ok(OutputFormat::Pfm),
+            Some("hdr") => Ok(OutputFormat::Hdr),
+            _ => Err(Error::image(path, "the output must end in .exr, .pfm or .hdr (linear) or .png (sRGB)")),
         }
     }
 }
@@ -313,8 +319,34 @@ pub fn write_png(path: &Path, rgb: &Bitmap) -> Result<()> {
     })
 }
 
+/// Write an RGB bitmap as a little-endian portable float map: the header `PF`, the size and
+/// -1 (little-endian), then the rows from the bottom one up.
+pub fn write_pfm(path: &Path, rgb: &Bitmap) -> Result<()> {
+    assert_eq!(rgb.channels, 3);
+    let mut bytes = format!("PF\n{} {}\n-1.0\n", rgb.width, rgb.height).into_bytes();
+    for row in rgb.data.chunks_exact(3 * rgb.width).rev() {
+        bytes.extend(row.iter().flat_map(|v| v.to_le_bytes()));
+    }
+    write_atomically(path, |tmp| std::fs::write(tmp, &bytes).map_err(|e| Error::io(path, e)))
+}
+
+/// Write an RGB bitmap as a Radiance HDR (RGBE) file, through the `image` crate's encoder.
+pub fn write_hdr(path: &Path, rgb: &Bitmap) -> Result<()> {
+    assert_eq!(rgb.channels, 3);
+    let pixels: Vec<::image::Rgb<f32>> = rgb.data.chunks_exact(3).map(|c| ::image::Rgb([c[0], c[1], c[2]])).collect();
+    write_atomically(path, |tmp| {
+        let file = std::fs::File::create(tmp).map_err(|e| Error::io(path, e))?;
+        ::image::codecs::hdr::HdrEncoder::new(std::io::BufWriter::new(file))
+            .encode(&pixels, rgb.width, rgb.height)
+            .map_err(|e| match e {
+                ::image::ImageError::IoError(io) => Error::io(path, io),
+                other => Error::image(path, format!("cannot write HDR: {other}")),
+            })
+    })
+}
+
 /// Write an RGB image and optional extra bitmaps (named channel groups, EXR only) in the format
-/// of `path`'s extension. PNG keeps only the RGB image.
+/// of `path`'s extension. PNG, PFM and HDR keep only the RGB image.
 pub fn write_image(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)]) -> Result<()> {
     write_image_in(path, rgb, extra, ExrWindow { origin: (0, 0), full: (rgb.width, rgb.height) })
 }
@@ -323,6 +355,8 @@ pub fn write_image(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)]) -> Re
 pub fn write_image_in(path: &Path, rgb: &Bitmap, extra: &[(&[&str], Bitmap)], window: ExrWindow) -> Result<()> {
     match OutputFormat::from_path(path)? {
         OutputFormat::Png => write_png(path, rgb),
+        OutputFormat::Pfm => write_pfm(path, rgb),
+        OutputFormat::Hdr => write_hdr(path, rgb),
         OutputFormat::Exr => {
             let mut channels = Vec::new();
             let mut push = |names: &[&str], b: &Bitmap| {
