@@ -446,6 +446,8 @@ struct TextureCache<'a> {
     path: &'a Path,
     file: &'a GltfFile,
     textures: &'a mut Vec<Texture>,
+    /// What the scene calls each of `textures`.
+    names: &'a mut Vec<String>,
     loaded: HashMap<(usize, ColorSpace), TextureId>,
 }
 
@@ -462,6 +464,9 @@ impl TextureCache<'_> {
             scale: Vec2::ONE,
             offset: Vec2::ZERO,
         }));
+        let file =
+            self.path.file_name().map_or_else(|| self.path.display().to_string(), |f| f.to_string_lossy().into());
+        self.names.push(format!("{file} image {image}"));
         let id = TextureId(self.textures.len() as u32 - 1);
         self.loaded.insert((image, space), id);
         Ok(id)
@@ -547,7 +552,7 @@ fn convert_material(
 /// lights with their intensities times `light_scale` (None: leave the lights out).
 pub(super) fn import_meshes(
     path: &Path,
-    textures: &mut Vec<Texture>,
+    (textures, names): (&mut Vec<Texture>, &mut Vec<String>),
     materials: &mut Vec<Material>,
     pbr_tables: fn() -> Arc<PlasticTables>,
     light_scale: Option<f32>,
@@ -555,7 +560,7 @@ pub(super) fn import_meshes(
     let file = read_gltf(path)?;
     guard_parser(path, || {
         let mut warnings = Vec::new();
-        let mut cache = TextureCache { path, file: &file, textures, loaded: HashMap::new() };
+        let mut cache = TextureCache { path, file: &file, textures, names, loaded: HashMap::new() };
         let first_material = materials.len() as u32;
         for m in file.doc.materials() {
             let material = convert_material(&m, &mut cache, pbr_tables(), &mut warnings)?;

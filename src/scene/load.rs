@@ -140,6 +140,8 @@ struct Loader<'a> {
     base: PathBuf,
     texture_descs: &'a std::collections::BTreeMap<String, TextureDesc>,
     textures: Vec<Texture>,
+    /// What the scene calls each of `textures`.
+    texture_names: Vec<String>,
     loaded_textures: HashMap<(String, ColorSpace), TextureId>,
     built_textures: HashMap<(String, ColorSpace), Texture>,
     textures_in_progress: Vec<String>,
@@ -156,6 +158,7 @@ impl<'a> Loader<'a> {
             base,
             texture_descs: &desc.textures,
             textures: Vec::new(),
+            texture_names: Vec::new(),
             loaded_textures: HashMap::new(),
             built_textures: HashMap::new(),
             textures_in_progress: Vec::new(),
@@ -277,6 +280,7 @@ impl<'a> Loader<'a> {
             accel,
             materials,
             textures: self.textures,
+            texture_names: self.texture_names,
             lights,
             warnings: self.warnings,
         })
@@ -315,7 +319,7 @@ impl<'a> Loader<'a> {
         if let Some(id) = self.loaded_textures.get(&key) {
             return Ok(*id);
         }
-        let id = self.add_texture(texture);
+        let id = self.add_texture(texture, format!("textures.{name}"));
         self.loaded_textures.insert(key, id);
         Ok(id)
     }
@@ -694,8 +698,9 @@ impl<'a> Loader<'a> {
         })
     }
 
-    fn add_texture(&mut self, texture: Texture) -> TextureId {
+    fn add_texture(&mut self, texture: Texture, name: String) -> TextureId {
         self.textures.push(texture);
+        self.texture_names.push(name);
         TextureId(self.textures.len() as u32 - 1)
     }
 
@@ -1014,8 +1019,14 @@ impl<'a> Loader<'a> {
                     return Err(self.error(format!("{item}.light_scale: {scale} is outside [0, {MAX_RADIANCE:e}]")));
                 }
                 let light_scale = shape.lights.unwrap_or(true).then_some(scale);
-                let import = super::gltf::import_meshes(&file, &mut self.textures, materials, pbr_tables, light_scale)
-                    .map_err(|e| e.in_scene(self.path, item))?;
+                let import = super::gltf::import_meshes(
+                    &file,
+                    (&mut self.textures, &mut self.texture_names),
+                    materials,
+                    pbr_tables,
+                    light_scale,
+                )
+                .map_err(|e| e.in_scene(self.path, item))?;
                 *file_lights = import.lights;
                 self.warnings
                     .extend(import.warnings.into_iter().map(|w| format!("{}: {item}: {w}", self.path.display())));

@@ -96,16 +96,16 @@ impl Exporter<'_> {
             Texture::Image(tex) => {
                 if tex.filter != Filter::None {
                     self.out.warnings.push(format!(
-                        "texture {} uses the {:?} filter; Mitsuba 3.9 has no MIP-mapping, so it is exported bilinear",
-                        id.0, tex.filter
+                        "{} uses the {:?} filter; Mitsuba 3.9 has no MIP-mapping, so it is exported bilinear",
+                        self.scene.texture_names[id.0 as usize], tex.filter
                     ));
                 }
                 (tex.scale, tex.offset)
             }
             Texture::TilingBlending(_) | Texture::QuadTiles(_) | Texture::Pups(_) => {
                 self.out.warnings.push(format!(
-                    "texture {} is procedural: baked over the UV square at {res}x{res} (lookups outside [0, 1] repeat the bake)",
-                    id.0,
+                    "{} is procedural: baked over the UV square at {res}x{res} (lookups outside [0, 1] repeat the bake)",
+                    self.scene.texture_names[id.0 as usize],
                     res = self.bake_res
                 ));
                 (Vec2::ONE, Vec2::ZERO)

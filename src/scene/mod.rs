@@ -158,6 +158,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Textures; materials index them.
     pub textures: Vec<Texture>,
+    /// What the scene calls each texture, by index (`textures.NAME`, or a glTF file's image),
+    /// for messages.
+    pub texture_names: Vec<String>,
     /// Lights.
     pub lights: Lights,
     /// Problems found while loading that did not stop it (degenerate triangles dropped, glTF
