@@ -92,6 +92,16 @@ fn malformed_obj_is_an_error() {
 }
 
 #[test]
+fn malformed_ply_is_an_error_naming_the_file() {
+    let scene = |file: &str| format!("{CAMERA}[[shapes]]\ntype = \"ply\"\nfilename = \"{file}\"\n");
+    error_of(&scene("bad.ply"), &[("bad.ply", b"ply\nformat ascii 1.0\nend_header\n")], &["bad.ply", "no triangles"]);
+    let truncated = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                      property float z\nend_header\n\x00\x00";
+    error_of(&scene("cut.ply"), &[("cut.ply", truncated)], &["cut.ply", "ends before"]);
+    error_of(&scene("text.ply"), &[("text.ply", b"solid cube\nendsolid\n")], &["text.ply", "end_header"]);
+}
+
+#[test]
 fn zero_area_triangles_are_dropped_with_a_warning() {
     let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 1 1 2\n";
     let dir = scene_dir(&obj_scene("some.obj"), &[("some.obj", obj)]);

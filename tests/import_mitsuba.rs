@@ -48,8 +48,9 @@ fn golden_scenes_round_trip_through_mitsuba_xml() {
 
 /// A scene in Mitsuba's own idioms: `$` defaults, a `<ref>`-erenced texture and BSDF, a
 /// `twosided` wrapper, a sensor whose field of view spans x by default and whose near clip is
-/// Mitsuba's default, a spot light placed by `lookat`, an analytic sphere, and things tessera
-/// does not have (a PLY shape, a Gaussian filter, a `principled` BSDF), each listed.
+/// Mitsuba's default, a spot light placed by `lookat`, an analytic sphere, a PLY mesh, and things
+/// tessera does not have (a serialized shape, a Gaussian filter, a `principled` BSDF), each
+/// listed.
 #[test]
 fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let xml = r#"<scene version="3.0.0">
@@ -67,7 +68,8 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         <bsdf type="roughconductor" id="gold"><string name="material" value="Al"/><float name="alpha" value="0.2"/></bsdf>
         <shape type="rectangle"><transform name="to_world"><scale value="5"/><rotate x="1" angle="-90"/></transform><ref id="floor"/></shape>
         <shape type="sphere"><point name="center" x="0" y="1" z="0"/><float name="radius" value="0.8"/><ref id="gold"/></shape>
-        <shape type="ply"><string name="filename" value="bunny.ply"/></shape>
+        <shape type="ply"><string name="filename" value="quad.ply"/></shape>
+        <shape type="serialized"><string name="filename" value="bunny.serialized"/></shape>
         <shape type="cube"><bsdf type="principled"/></shape>
         <emitter type="spot">
             <transform name="to_world"><lookat origin="2, 4, 2" target="0, 0, 0"/></transform>
@@ -75,10 +77,12 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         </emitter>
         <emitter type="constant"><rgb name="radiance" value="0.1"/></emitter>
     </scene>"#;
-    let dir = common::scene_dir("", &[("scene.xml", xml.as_bytes()), ("checker.png", &checker_png())]);
+    let files: [(&str, &[u8]); 3] =
+        [("scene.xml", xml.as_bytes()), ("checker.png", &checker_png()), ("quad.ply", QUAD_PLY.as_bytes())];
+    let dir = common::scene_dir("", &files);
     let import = import_mitsuba(&dir.path().join("scene.xml"), dir.path()).unwrap();
     let gaps = import.untranslated.join("\n");
-    for expected in ["type=\"ply\"", "gaussian", "principled", "sphere"] {
+    for expected in ["type=\"serialized\"", "gaussian", "principled", "sphere"] {
         assert!(gaps.contains(expected), "{expected} should be listed:\n{gaps}");
     }
     let path = dir.path().join("imported.toml");
@@ -103,7 +107,7 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let spot = &scene.lights.points[0];
     assert!(spot.spot.unwrap().axis().distance(-glam::Vec3::new(2.0, 4.0, 2.0).normalize()) < 1e-5);
     assert!(scene.materials.iter().any(|m| m.name == "materials.floor" && m.two_sided));
-    assert_eq!(scene.geometry.shapes.len(), 3, "rectangle, sphere, cube (the PLY is left out)");
+    assert_eq!(scene.geometry.shapes.len(), 4, "rectangle, sphere, PLY, cube (the serialized shape is left out)");
 }
 
 fn checker_png() -> Vec<u8> {
@@ -172,4 +176,36 @@ fn the_command_writes_only_a_scene_that_loads() {
         tessera::camera::Projection::Orthographic { extent: 4.0, axis: tessera::camera::FovAxis::X }
     );
     assert_eq!(scene.lights.points.len(), 1);
+}
+
+/// A quad whose texture coordinates follow x and y.
+const QUAD_PLY: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+    property float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\n\
+    end_header\n-1 -1 0 0 0\n1 -1 0 1 0\n1 1 0 1 1\n-1 1 0 0 1\n4 0 1 2 3\n";
+
+/// PLY texture coordinates are read as Mitsuba 3.9.1 reads them. Rendered there, a quad as PLY
+/// and the same quad as OBJ (the same u, v per vertex) show the texture mirrored top to bottom
+/// (Mitsuba flips an OBJ's v, not a PLY's), so tessera's PLY uv must be the OBJ's (u, 1 - v):
+/// checked pixel by pixel on the uv AOV, same samples on both sides.
+#[test]
+fn ply_texture_coordinates_run_as_mitsuba_reads_them() {
+    let obj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+    let scene = |file: &str| {
+        format!(
+            "[render]\nwidth = 16\nheight = 16\nspp = 2\n[camera]\nprojection = \"orthographic\"\nextent = 1.5\n\
+             eye = [0, 0, 3]\ntarget = [0, 0, 0]\n[environment]\ntype = \"constant\"\nradiance = 1\n\
+             [[shapes]]\ntype = \"{}\"\nfilename = \"{file}\"\n",
+            &file[file.len() - 3..]
+        )
+    };
+    let uv = |file: &str| {
+        let files: [(&str, &[u8]); 2] = [("quad.ply", QUAD_PLY.as_bytes()), ("quad.obj", obj.as_bytes())];
+        let (_dir, scene) = common::scene(&scene(file), &files);
+        let film = tessera::integrator::render(&scene, None, &[tessera::image::Aov::Uv], &|_, _| {});
+        film.aov(tessera::image::Aov::Uv).unwrap()
+    };
+    let (from_ply, from_obj) = (uv("quad.ply"), uv("quad.obj"));
+    for (p, o) in from_ply.data.chunks(2).zip(from_obj.data.chunks(2)) {
+        assert!((p[0] - o[0]).abs() < 1e-6 && (p[1] - (1.0 - o[1])).abs() < 1e-6, "PLY {p:?} against OBJ {o:?}");
+    }
 }

@@ -6,6 +6,7 @@ mod frame;
 mod interaction;
 mod mesh;
 pub mod obj;
+pub mod ply;
 mod quad_mesh;
 mod ray;
 pub mod shapes;

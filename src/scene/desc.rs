@@ -480,10 +480,10 @@ pub enum MaterialDesc {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeDesc {
-    /// `obj`, `gltf`, `rectangle`, `cube` or `uv_sphere`.
+    /// `obj`, `ply`, `gltf`, `rectangle`, `cube` or `uv_sphere`.
     #[serde(rename = "type")]
     pub kind: ShapeKind,
-    /// Mesh file (obj, gltf).
+    /// Mesh file (obj, ply, gltf).
     pub filename: Option<String>,
     /// Segments around the axis (uv_sphere, default 64).
     pub segments: Option<u32>,
@@ -513,6 +513,8 @@ pub struct ShapeDesc {
 pub enum ShapeKind {
     /// Wavefront OBJ file.
     Obj,
+    /// Stanford PLY file (ASCII or binary), read as Mitsuba 3 reads it.
+    Ply,
     /// glTF 2.0 file (.gltf or .glb): meshes, node transforms and materials.
     Gltf,
     /// [-1, 1]^2 in z = 0, facing +z.

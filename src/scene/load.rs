@@ -13,7 +13,7 @@ use crate::camera::{Camera, CameraModel, FovAxis, Projection, ThinLens};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::read_text_bounded;
-use crate::geometry::{TriangleMesh, obj, shapes};
+use crate::geometry::{TriangleMesh, obj, ply, shapes};
 use crate::image::{ColorSpace, read_bitmap, read_bitmap_raw};
 use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::limits;
@@ -993,12 +993,12 @@ impl<'a> Loader<'a> {
         materials: &mut Vec<Material>,
         file_lights: &mut Lights,
     ) -> Result<Vec<(TriangleMesh, Option<u32>)>> {
-        let needs_file = matches!(shape.kind, ShapeKind::Obj | ShapeKind::Gltf);
+        let needs_file = matches!(shape.kind, ShapeKind::Obj | ShapeKind::Ply | ShapeKind::Gltf);
         if needs_file != shape.filename.is_some() {
             return Err(self.error(if needs_file {
                 format!("{item}: a {:?} shape needs a filename", shape.kind).to_lowercase()
             } else {
-                format!("{item}: only obj and gltf shapes take a filename")
+                format!("{item}: only obj, ply and gltf shapes take a filename")
             }));
         }
         if shape.kind != ShapeKind::UvSphere && (shape.segments.is_some() || shape.rings.is_some()) {
@@ -1011,6 +1011,10 @@ impl<'a> Loader<'a> {
             ShapeKind::Obj => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
                 vec![(obj::load_obj(&file).map_err(|e| e.in_scene(self.path, item))?, None)]
+            }
+            ShapeKind::Ply => {
+                let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
+                vec![(ply::load_ply(&file).map_err(|e| e.in_scene(self.path, item))?, None)]
             }
             ShapeKind::Gltf => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));

@@ -2,8 +2,8 @@
 //! Mitsuba does, translated into a scene file, and a list of everything that was not.
 //!
 //! Translated: `<default>` parameters (`$name`); the `path` integrator; `perspective`,
-//! `thinlens` and `orthographic` sensors with their film and sampler; `obj`, `rectangle` and
-//! `cube` shapes (and `sphere`, as a fine UV-sphere mesh); transforms; the BSDFs tessera has
+//! `thinlens` and `orthographic` sensors with their film and sampler; `obj`, `ply`, `rectangle`
+//! and `cube` shapes (and `sphere`, as a fine UV-sphere mesh); transforms; the BSDFs tessera has
 //! (`diffuse`, `conductor`, `roughconductor`, `dielectric`, `roughdielectric`, `roughplastic`,
 //! wrapped in `twosided` and `normalmap`), `bitmap` textures and `<ref>`s to them; `area`,
 //! `point`, `spot`, `directional`, `constant` and `envmap` emitters. Each item that is not
@@ -617,8 +617,8 @@ impl Importer {
         let mut shape = Table::new();
         let mut m = self.to_world(node)?.unwrap_or(Mat4::IDENTITY);
         match kind {
-            "obj" => {
-                shape.insert("type".into(), "obj".into());
+            "obj" | "ply" => {
+                shape.insert("type".into(), kind.into());
                 let f = self.string(node, "filename").ok_or_else(|| format!("{}: no filename", at(node)))?;
                 shape.insert("filename".into(), self.file(&f).into());
                 if self.boolean(node, "face_normals") {

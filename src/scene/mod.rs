@@ -22,7 +22,8 @@ pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Opti
     let (mesh, tangents) = match extension.as_deref() {
         Some("gltf" | "glb") => gltf::import_surface(path)?,
         Some("obj") => (crate::geometry::obj::load_obj(path)?, None),
-        _ => return Err(crate::Error::mesh(path, "expected a mesh file ending in .obj, .gltf or .glb")),
+        Some("ply") => (crate::geometry::ply::load_ply(path)?, None),
+        _ => return Err(crate::Error::mesh(path, "expected a mesh file ending in .obj, .ply, .gltf or .glb")),
     };
     mesh.check().map_err(|msg| crate::Error::mesh(path, msg))?;
     Ok((mesh, tangents))
