@@ -82,7 +82,7 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let dir = common::scene_dir("", &files);
     let import = import_mitsuba(&dir.path().join("scene.xml"), dir.path()).unwrap();
     let gaps = import.untranslated.join("\n");
-    for expected in ["type=\"serialized\"", "gaussian", "principled", "sphere"] {
+    for expected in ["type=\"serialized\"", "gaussian", "principled", "sphere", "Beckmann"] {
         assert!(gaps.contains(expected), "{expected} should be listed:\n{gaps}");
     }
     let path = dir.path().join("imported.toml");

@@ -506,8 +506,16 @@ impl Importer {
                 Err(_) => Value::String(v),
             }))
         };
-        if let Some(d) = self.string(inner, "distribution").filter(|d| d != "ggx") {
-            self.skip(format!("{}: distribution '{d}' rendered as GGX", at(inner)));
+        // Mitsuba's rough BSDFs default to Beckmann; tessera's microfacets are GGX.
+        if kind.starts_with("rough") {
+            match self.string(inner, "distribution") {
+                Some(d) if d == "ggx" => {}
+                Some(d) => self.skip(format!("{}: distribution '{d}' rendered as GGX", at(inner))),
+                None => self.skip(format!(
+                    "{}: no distribution given: Mitsuba's default, Beckmann, is rendered as GGX",
+                    at(inner)
+                )),
+            }
         }
         match kind.as_str() {
             "diffuse" => {
