@@ -31,6 +31,9 @@ pub struct SpotCone {
     beam: f32,
     /// Half-angle (radians) beyond which no light leaves.
     cutoff: f32,
+    /// Their cosines, compared with every shadow ray's.
+    cos_beam: f32,
+    cos_cutoff: f32,
     falloff: SpotFalloff,
 }
 
@@ -51,7 +54,7 @@ impl SpotCone {
                 cutoff.to_degrees()
             ));
         }
-        Ok(SpotCone { axis, beam, cutoff, falloff })
+        Ok(SpotCone { axis, beam, cutoff, cos_beam: beam.cos(), cos_cutoff: cutoff.cos(), falloff })
     }
 
     /// The axis (unit).
@@ -72,7 +75,7 @@ impl SpotCone {
     /// The fraction s of the axis' intensity leaving along unit direction `w`.
     pub fn profile(&self, w: Vec3) -> f32 {
         let cos_theta = w.dot(self.axis).clamp(-1.0, 1.0);
-        let (cos_beam, cos_cutoff) = (self.beam.cos(), self.cutoff.cos());
+        let (cos_beam, cos_cutoff) = (self.cos_beam, self.cos_cutoff);
         if cos_theta <= cos_cutoff {
             return 0.0;
         }

@@ -442,6 +442,11 @@ fn decode_image(path: &Path, file: &GltfFile, index: usize, space: ColorSpace) -
     decode_image_bytes(&bytes, path, space).map_err(|e| error(e.to_string()))
 }
 
+/// The file's name without its folder, as messages name a glTF file's materials and images.
+fn file_name(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |f| f.to_string_lossy().into())
+}
+
 struct TextureCache<'a> {
     path: &'a Path,
     file: &'a GltfFile,
@@ -464,8 +469,7 @@ impl TextureCache<'_> {
             scale: Vec2::ONE,
             offset: Vec2::ZERO,
         }));
-        let file =
-            self.path.file_name().map_or_else(|| self.path.display().to_string(), |f| f.to_string_lossy().into());
+        let file = file_name(self.path);
         self.names.push(format!("{file} image {image}"));
         let id = TextureId(self.textures.len() as u32 - 1);
         self.loaded.insert((image, space), id);
@@ -528,8 +532,7 @@ fn convert_material(
     if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
         warnings.push(format!("material '{name}': alpha mode {:?} ignored (rendered opaque)", m.alpha_mode()));
     }
-    let file_name =
-        cache.path.file_name().map_or_else(|| cache.path.display().to_string(), |f| f.to_string_lossy().into());
+    let file_name = file_name(cache.path);
     Ok(Material {
         name: format!("{file_name} material {} '{name}'", m.index().map_or("default".into(), |i| i.to_string())),
         kind: MaterialKind::Pbr {
