@@ -170,6 +170,17 @@ fn absurd_parameters_are_rejected() {
         &["emission", "outside [0, 1e15]"],
     );
     error_of(&format!("{CAMERA}[[shapes]]\ntype = \"rectangle\"\ntransform = [{{ scale = 0 }}]\n"), &[], &["singular"]);
+    // Spheres: a radius that is not positive, an ellipsoid, keys of other shapes.
+    for radius in ["0", "-1", "1e30"] {
+        error_of(&format!("{CAMERA}[[shapes]]\ntype = \"sphere\"\nradius = {radius}\n"), &[], &["shapes[0]", "radius"]);
+    }
+    error_of(
+        &format!("{CAMERA}[[shapes]]\ntype = \"sphere\"\ntransform = [{{ scale = [1, 2, 1] }}]\n"),
+        &[],
+        &["shapes[0]", "ellipsoid"],
+    );
+    error_of(&format!("{CAMERA}[[shapes]]\ntype = \"sphere\"\nsegments = 8\n"), &[], &["uv_sphere only"]);
+    error_of(&format!("{CAMERA}[[shapes]]\ntype = \"cube\"\nradius = 2\n"), &[], &["sphere only"]);
 }
 
 #[test]

@@ -1,16 +1,16 @@
 //! Chi-square goodness of fit of light sampling against the densities the integrator uses for
-//! multiple importance sampling: environment maps and area lights.
+//! multiple importance sampling: environment maps, area lights and emitting spheres.
 
 mod common;
 
 use common::{Chi2, sidak};
 use glam::{Vec2, Vec3};
 use tessera::accel::Accel;
-use tessera::geometry::Ray;
+use tessera::geometry::{Ray, Sphere};
 use tessera::image::{Bitmap, ColorSpace, read_bitmap};
 use tessera::light::{AreaLight, Environment, EnvironmentMap};
 
-const TESTS: usize = 4;
+const TESTS: usize = 6;
 
 #[test]
 fn environment_map_sampling_matches_pdf_chi2() {
@@ -69,13 +69,13 @@ fn area_light_sampling_matches_pdf_chi2() {
         [Vec3::new(-1.5, -1.0, 0.2), Vec3::new(-1.0, -2.0, 0.2), Vec3::new(-0.5, -1.5, 0.3)],
     ];
     let light = AreaLight::new(quad.to_vec(), tessera::color::Rgb::ONE);
-    let accel = Accel::build(&quad);
+    let accel = Accel::build(&quad, &[]);
     let p = Vec3::new(0.1, 0.2, -0.3);
     let pdf = |w: Vec3| {
         let Some(hit) = accel.intersect(&Ray::new(p, w)) else { return 0.0 };
-        let [a, b, c] = quad[hit.triangle as usize];
+        let [a, b, c] = quad[hit.primitive as usize];
         let q = a * (1.0 - hit.b1 - hit.b2) + b * hit.b1 + c * hit.b2;
-        light.pdf(p, q, (b - a).cross(c - a).normalize())
+        light.pdf(p, w.normalize(), q, (b - a).cross(c - a).normalize())
     };
     // The density ends abruptly at the triangles' edges: integrate finely (40 x 40 nodes).
     let chi2 = Chi2 { nodes: 40, ..Chi2::default() };
@@ -89,4 +89,28 @@ fn area_light_sampling_matches_pdf_chi2() {
         (fraction - expected).abs() < 0.005 && (outcome.integral as f32 - expected).abs() < 0.005,
         "{outcome:?}, expected {expected}"
     );
+}
+
+/// An emitting sphere seen from outside (its directions uniform over the cone it subtends) and
+/// from inside (its points uniform by area): samples against the density the integrator weighs
+/// a path's hit with, found by tracing each direction to the sphere.
+#[test]
+fn sphere_light_sampling_matches_pdf_chi2() {
+    let to_world = glam::Mat4::from_translation(Vec3::new(0.3, -0.2, 1.5)) * glam::Mat4::from_scale(Vec3::splat(0.9));
+    for (seed, p, flip) in [(24, Vec3::new(0.1, 0.2, -0.3), false), (25, Vec3::new(0.5, 0.1, 1.2), true)] {
+        let sphere = Sphere::new(to_world, flip).unwrap();
+        let light = AreaLight::sphere(sphere.clone(), tessera::color::Rgb::ONE);
+        let accel = Accel::build(&[], std::slice::from_ref(&sphere));
+        let pdf = |w: Vec3| {
+            let ray = Ray::new(p, w);
+            let Some(hit) = accel.intersect(&ray) else { return 0.0 };
+            let q = ray.at(hit.t);
+            let n = (q - sphere.center()).normalize() * if flip { -1.0 } else { 1.0 };
+            light.pdf(p, w.normalize(), q, n)
+        };
+        let outcome =
+            Chi2 { nodes: 40, ..Chi2::default() }.run(seed, |_, u: Vec2| light.sample(p, u).map(|s| s.wi), pdf);
+        assert!(outcome.p_value > sidak(TESTS) && outcome.in_zero_cells == 0, "flip {flip}: {outcome:?}");
+        assert!((outcome.integral - 1.0).abs() < 5e-3, "flip {flip}: {outcome:?}");
+    }
 }

@@ -48,9 +48,9 @@ fn golden_scenes_round_trip_through_mitsuba_xml() {
 
 /// A scene in Mitsuba's own idioms: `$` defaults, a `<ref>`-erenced texture and BSDF, a
 /// `twosided` wrapper, a sensor whose field of view spans x by default and whose near clip is
-/// Mitsuba's default, a spot light placed by `lookat`, an analytic sphere, a PLY mesh, and things
-/// tessera does not have (a serialized shape, a Gaussian filter, a `principled` BSDF), each
-/// listed.
+/// Mitsuba's default, a spot light placed by `lookat`, an exact sphere, a PLY mesh, and things
+/// tessera does not have (a serialized shape, a Gaussian filter, a `principled` BSDF, a sphere
+/// scaled unevenly), each listed.
 #[test]
 fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let xml = r#"<scene version="3.0.0">
@@ -68,6 +68,7 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         <bsdf type="roughconductor" id="gold"><string name="material" value="Al"/><float name="alpha" value="0.2"/></bsdf>
         <shape type="rectangle"><transform name="to_world"><scale value="5"/><rotate x="1" angle="-90"/></transform><ref id="floor"/></shape>
         <shape type="sphere"><point name="center" x="0" y="1" z="0"/><float name="radius" value="0.8"/><ref id="gold"/></shape>
+        <shape type="sphere"><transform name="to_world"><scale x="0.2" y="0.4" z="0.2"/><translate x="2"/></transform></shape>
         <shape type="ply"><string name="filename" value="quad.ply"/></shape>
         <shape type="serialized"><string name="filename" value="bunny.serialized"/></shape>
         <shape type="cube"><bsdf type="principled"/></shape>
@@ -82,7 +83,7 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let dir = common::scene_dir("", &files);
     let import = import_mitsuba(&dir.path().join("scene.xml"), dir.path()).unwrap();
     let gaps = import.untranslated.join("\n");
-    for expected in ["type=\"serialized\"", "gaussian", "principled", "sphere", "Beckmann"] {
+    for expected in ["type=\"serialized\"", "gaussian", "principled", "ellipsoid", "Beckmann"] {
         assert!(gaps.contains(expected), "{expected} should be listed:\n{gaps}");
     }
     let path = dir.path().join("imported.toml");
@@ -107,7 +108,10 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let spot = &scene.lights.points[0];
     assert!(spot.spot.unwrap().axis().distance(-glam::Vec3::new(2.0, 4.0, 2.0).normalize()) < 1e-5);
     assert!(scene.materials.iter().any(|m| m.name == "materials.floor" && m.two_sided));
-    assert_eq!(scene.geometry.shapes.len(), 4, "rectangle, sphere, PLY, cube (the serialized shape is left out)");
+    assert_eq!(scene.geometry.shapes.len(), 5, "rectangle, 2 spheres, PLY, cube (the serialized shape is left out)");
+    // The sphere is exact; the unevenly scaled one a mesh.
+    let [sphere] = &scene.geometry.spheres[..] else { panic!("one exact sphere") };
+    assert_eq!((sphere.center(), sphere.radius()), (glam::Vec3::Y, 0.8));
 }
 
 fn checker_png() -> Vec<u8> {

@@ -57,6 +57,15 @@ fn enclosure_radiance_counts_path_segments_like_mitsuba() {
     assert_mean(&enclosure("cube", a, 4), &[], 1.0 + a + a * a + a * a * a, 1e-4, "max_depth 4");
 }
 
+/// The same inside an exact sphere turned inside out: its normals are exact, so it holds as
+/// for the cube (light sampling from inside picks points by area).
+#[test]
+fn enclosure_radiance_inside_an_exact_sphere() {
+    let a = 0.5;
+    assert_mean(&enclosure("sphere", a, 2), &[], 1.0 + a, 1e-4, "exact sphere, max_depth 2");
+    assert_mean(&enclosure("sphere", a, 4), &[], 1.0 + a + a * a + a * a * a, 1e-4, "exact sphere, max_depth 4");
+}
+
 #[test]
 fn enclosure_furnace_with_russian_roulette_is_unbiased() {
     let a = 0.7;
@@ -83,13 +92,14 @@ fn square_light_over_diffuse_floor_matches_form_factor() {
     assert_mean(&toml, &[], rho * le * form_factor, 1e-4, "floor under a square light");
 }
 
-/// A perfect glass sphere and a perfect mirror sphere in a uniform white sky: lossless
-/// scattering preserves radiance (refraction's 1/eta^2 in and eta^2 out cancel), so every pixel
-/// is 1 with unlimited depth.
+/// A perfect glass sphere and a perfect mirror sphere in a uniform white sky, as a mesh and
+/// exact: lossless scattering preserves radiance (refraction's 1/eta^2 in and eta^2 out
+/// cancel), so every pixel is 1 with unlimited depth.
 #[test]
 fn lossless_spheres_in_white_sky_are_invisible() {
-    for material in ["type = \"dielectric\"\nint_ior = 1.5\next_ior = 1.0", "type = \"conductor\"\nmaterial = \"none\""]
-    {
+    let materials =
+        ["type = \"dielectric\"\nint_ior = 1.5\next_ior = 1.0", "type = \"conductor\"\nmaterial = \"none\""];
+    for (material, shape) in materials.iter().flat_map(|m| ["uv_sphere", "sphere"].map(|s| (m, s))) {
         let toml = format!(
             r#"
             [render]
@@ -106,11 +116,11 @@ fn lossless_spheres_in_white_sky_are_invisible() {
             [materials.m]
             {material}
             [[shapes]]
-            type = "uv_sphere"
+            type = "{shape}"
             material = "m"
             "#
         );
-        assert_mean(&toml, &[], 1.0, 1e-3, material);
+        assert_mean(&toml, &[], 1.0, 1e-3, &format!("{shape}: {material}"));
     }
 }
 
@@ -221,7 +231,7 @@ fn normal_mapped_mirror_under_uniform_sky_matches_its_model() {
     let (_dir, scene) = common::scene(toml, &[("n.png", &png)]);
     let (ray, _) = scene.camera.generate_ray(Vec2::new(4.5, 4.5), glam::Vec2::ZERO);
     let si = scene.intersect(&ray).unwrap();
-    let material = &scene.materials[scene.shape_of(si.triangle).material as usize];
+    let material = &scene.materials[scene.shape_of(si.primitive).material as usize];
     let ctx = TexCtx { uv: si.uv, ..Default::default() };
     let bsdf = material.bsdf(&scene.textures, &ctx);
     let shading = material.shading(&scene.textures, &ctx, si.frame, si.dpdu, si.dpdv);
@@ -313,6 +323,21 @@ fn lit_floor(rho: f64, lights: &str, shapes: &str) -> String {
         {lights}
         "#
     )
+}
+
+/// An emitting exact sphere (radius r, radiance L) whose centre is at distance d from the
+/// floor's origin, at the angle beta from the normal, wholly above the horizon: it subtends a
+/// cap of sin alpha = r / d, and E = pi L (r / d)^2 cos beta (the sphere's irradiance is that of
+/// a point of intensity L pi r^2 at its centre). Light sampling picks directions in that cap;
+/// BSDF samples hit it often, so the MIS weights of both must add up.
+#[test]
+fn sphere_light_over_a_floor_matches_its_irradiance() {
+    let (rho, l, r) = (0.5, 2.0, 0.5);
+    let (x, h) = (0.8f64, 1.5f64);
+    let d = x.hypot(h);
+    let light = format!("[[shapes]]\ntype = \"sphere\"\ncenter = [{x}, {h}, 0]\nradius = {r}\nemission = {l}");
+    let expected = rho / PI * PI * l * (r / d).powi(2) * (h / d);
+    assert_mean(&lit_floor(rho, "", &light), &[], expected, 1e-4, "sphere light");
 }
 
 /// Point and spot lights at height h = 2 over the floor: E = I s(theta) / h^2, with the spot's

@@ -278,7 +278,7 @@ impl Bvh4 {
         self.traverse::<true>(&RayBoxes::new(ray), ray.t_max, |leaf, t_max| {
             for p in leaf.packets() {
                 if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&self.packets[p], *t_max) {
-                    closest = Some(Hit { triangle: self.packet_triangles[p][lane], t, b1, b2 });
+                    closest = Some(Hit { primitive: self.packet_triangles[p][lane], t, b1, b2 });
                     *t_max = t;
                 }
             }
@@ -334,7 +334,7 @@ impl Bvh4 {
                 }
                 for p in leaf.packets() {
                     if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&self.packets[p], t_max[k]) {
-                        hits[index[k]] = Some(Hit { triangle: self.packet_triangles[p][lane], t, b1, b2 });
+                        hits[index[k]] = Some(Hit { primitive: self.packet_triangles[p][lane], t, b1, b2 });
                         t_max[k] = t;
                     }
                 }

@@ -188,7 +188,7 @@ impl EmbreeScene {
         let hit = &rayhit.hit;
         (hit.geom_id != RTC_INVALID_GEOMETRY_ID).then_some(Hit {
             t: rayhit.ray.tfar,
-            triangle: hit.prim_id,
+            primitive: hit.prim_id,
             b1: hit.u,
             b2: hit.v,
         })

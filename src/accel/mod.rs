@@ -1,32 +1,37 @@
-//! Ray-scene intersection: closest hit and occlusion over all triangles of a scene.
+//! Ray-scene intersection: closest hit and occlusion over all triangles and spheres of a scene.
 //!
 //! obvhs builds a binary BVH (PLOC with reinsertion, SAH-sized leaves), which `bvh4.rs` collapses
 //! into a four-wide BVH with four-triangle leaf packets for SIMD traversal on the CPU; it
 //! measured faster than obvhs's own CWBVH and BVH2 traversals for the incoherent rays of path
 //! tracing (DESIGN.md section 2). Triangles are tested with the watertight algorithm of Woop,
 //! Benthin and Wald (2013), so that no ray slips between two triangles that share an edge.
-//! With the feature `embree`, Embree 3 is available too, and is the default backend.
+//! With the feature `embree`, Embree 3 is available too, and is the default backend. Exact
+//! spheres are intersected by tessera whatever the backend (`spheres.rs`).
 
 mod bvh4;
 #[cfg(feature = "embree")]
 mod embree;
+mod spheres;
 mod watertight;
 
-use crate::geometry::Ray;
+use crate::geometry::{Ray, Sphere};
 use bvh4::Bvh4;
 use glam::Vec3;
 use obvhs::{BvhBuildParams, triangle::Triangle};
+use spheres::SphereSet;
 
-/// A closest hit: the triangle, the ray parameter and the barycentric coordinates.
+/// A closest hit: the primitive, the ray parameter and, on a triangle, the barycentric
+/// coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     /// Ray parameter of the hit.
     pub t: f32,
-    /// Index of the triangle in the slice the accelerator was built from.
-    pub triangle: u32,
-    /// Barycentric weight of the triangle's second vertex.
+    /// Index of the primitive: a triangle's in the slice the accelerator was built from, or the
+    /// number of triangles plus a sphere's index in its slice.
+    pub primitive: u32,
+    /// Barycentric weight of the triangle's second vertex (0 on a sphere).
     pub b1: f32,
-    /// Barycentric weight of the triangle's third vertex.
+    /// Barycentric weight of the triangle's third vertex (0 on a sphere).
     pub b2: f32,
 }
 
@@ -59,22 +64,24 @@ enum Backend {
     Embree(embree::EmbreeScene),
 }
 
-/// Bounding volume hierarchy over a fixed set of triangles.
+/// Bounding volume hierarchies over a fixed set of triangles and spheres.
 pub struct Accel {
     backend: Backend,
     triangle_count: usize,
+    spheres: Option<SphereSet>,
 }
 
 impl Accel {
-    /// Build the default kind over `triangles`. Triangles of zero area are allowed: they are
-    /// never hit.
-    pub fn build(triangles: &[[Vec3; 3]]) -> Self {
-        Self::build_kind(triangles, AccelKind::DEFAULT)
+    /// Build the default kind over `triangles` and `spheres`. Triangles of zero area are
+    /// allowed: they are never hit.
+    pub fn build(triangles: &[[Vec3; 3]], spheres: &[Sphere]) -> Self {
+        Self::build_kind(triangles, spheres, AccelKind::DEFAULT)
     }
 
-    /// Build `kind` over `triangles`. Where Embree fails to build (an unsupported CPU), this
-    /// says so and builds the four-wide BVH instead.
-    pub fn build_kind(triangles: &[[Vec3; 3]], kind: AccelKind) -> Self {
+    /// Build `kind` over `triangles` (the spheres have their own BVH, the same for every kind).
+    /// Where Embree fails to build (an unsupported CPU), this says so and builds the four-wide
+    /// BVH instead.
+    pub fn build_kind(triangles: &[[Vec3; 3]], spheres: &[Sphere], kind: AccelKind) -> Self {
         let backend = if triangles.is_empty() {
             Backend::Empty
         } else {
@@ -90,12 +97,17 @@ impl Accel {
                 },
             }
         };
-        Accel { backend, triangle_count: triangles.len() }
+        Accel { backend, triangle_count: triangles.len(), spheres: SphereSet::build(spheres) }
     }
 
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangle_count
+    }
+
+    /// Number of spheres.
+    pub fn sphere_count(&self) -> usize {
+        self.spheres.as_ref().map_or(0, SphereSet::len)
     }
 
     /// Approximate memory held, in bytes (Embree's own is not counted).
@@ -109,11 +121,23 @@ impl Accel {
     /// The closest hit with `0 < t < ray.t_max`, if any.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        match &self.backend {
+        let triangle = match &self.backend {
             Backend::Empty => None,
             Backend::Bvh4(bvh) => bvh.intersect(ray),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.intersect(ray),
+        };
+        self.closer_sphere(ray, triangle)
+    }
+
+    /// `hit` (a triangle's, or none), or the closest sphere before it.
+    #[inline]
+    fn closer_sphere(&self, ray: &Ray, hit: Option<Hit>) -> Option<Hit> {
+        let Some(spheres) = &self.spheres else { return hit };
+        let before = Ray { t_max: hit.map_or(ray.t_max, |h| h.t), ..*ray };
+        match spheres.intersect(&before) {
+            Some((t, i)) => Some(Hit { t, primitive: self.triangle_count as u32 + i, b1: 0.0, b2: 0.0 }),
+            None => hit,
         }
     }
 
@@ -125,20 +149,24 @@ impl Accel {
         for (rays, hits) in rays.chunks(32).zip(hits.chunks_mut(32)) {
             match &self.backend {
                 Backend::Bvh4(bvh) => bvh.intersect_many(rays, hits),
-                _ => rays.iter().zip(hits).for_each(|(r, h)| *h = self.intersect(r)),
+                _ => rays.iter().zip(hits.iter_mut()).for_each(|(r, h)| *h = self.intersect(r)),
+            }
+            if let Backend::Bvh4(_) = &self.backend {
+                rays.iter().zip(hits).for_each(|(r, h)| *h = self.closer_sphere(r, *h));
             }
         }
     }
 
-    /// True when any triangle lies on the ray with `0 < t < ray.t_max`.
+    /// True when any triangle or sphere lies on the ray with `0 < t < ray.t_max`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        match &self.backend {
+        let triangle = match &self.backend {
             Backend::Empty => false,
             Backend::Bvh4(bvh) => bvh.occluded(ray),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.occluded(ray),
-        }
+        };
+        triangle || self.spheres.as_ref().is_some_and(|s| s.occluded(ray))
     }
 }
 
@@ -202,7 +230,7 @@ mod tests {
 
     /// Every backend this build has, built over `tris`.
     fn each_kind(tris: &[[Vec3; 3]]) -> impl Iterator<Item = (AccelKind, Accel)> {
-        AccelKind::ALL.iter().map(|&kind| (kind, Accel::build_kind(tris, kind)))
+        AccelKind::ALL.iter().map(|&kind| (kind, Accel::build_kind(tris, &[], kind)))
     }
 
     #[test]
@@ -220,14 +248,14 @@ mod tests {
                 }
                 let expected = brute_force(&tris, &ray);
                 let got = accel.intersect(&ray);
-                assert_eq!(expected.map(|e| e.1), got.map(|g| g.triangle), "{kind:?}: ray {ray:?}");
+                assert_eq!(expected.map(|e| e.1), got.map(|g| g.primitive), "{kind:?}: ray {ray:?}");
                 if let (Some(e), Some(g)) = (expected, got) {
                     if kind == AccelKind::Bvh4 {
                         assert_eq!(e.0, g.t); // the same triangle test
                     } else {
                         assert!((e.0 - g.t).abs() <= 1e-5 * e.0.max(1.0), "{kind:?}: t {} vs {}", g.t, e.0);
                     }
-                    let [a, b, c] = tris[g.triangle as usize];
+                    let [a, b, c] = tris[g.primitive as usize];
                     let p = a * (1.0 - g.b1 - g.b2) + b * g.b1 + c * g.b2;
                     assert!(p.distance(ray.at(g.t)) < 1e-4, "barycentrics disagree with t");
                     hits += 1;
@@ -250,7 +278,7 @@ mod tests {
                 let target = if i % 2 == 0 { (a + b + c) / 3.0 } else { rng.vec(2e4) };
                 let ray = Ray::new(o, target - o);
                 let expected = brute_force(&tris, &ray);
-                assert_eq!(expected.map(|e| e.1), accel.intersect(&ray).map(|h| h.triangle), "{kind:?}: ray {ray:?}");
+                assert_eq!(expected.map(|e| e.1), accel.intersect(&ray).map(|h| h.primitive), "{kind:?}: ray {ray:?}");
                 assert_eq!(expected.is_some(), accel.occluded(&ray));
             }
         }
@@ -282,7 +310,7 @@ mod tests {
                     })
                     .collect();
                 // Stale answers in the output, which every query must overwrite.
-                let mut hits = vec![Some(Hit { t: 1.0, triangle: 0, b1: 0.0, b2: 0.0 }); n];
+                let mut hits = vec![Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }); n];
                 accel.intersect_many(&rays, &mut hits);
                 for (i, ray) in rays.iter().enumerate() {
                     assert_eq!(hits[i], accel.intersect(ray), "{kind:?}: ray {i} of batch {batch}: {ray:?}");
@@ -294,8 +322,51 @@ mod tests {
     }
 
     #[test]
+    fn spheres_among_triangles_are_hit_as_brute_force_finds_them() {
+        let mut rng = Lcg(23);
+        let tris = random_scene(&mut rng, 500);
+        let spheres: Vec<Sphere> = (0..60)
+            .map(|_| {
+                let to_world =
+                    glam::Mat4::from_translation(rng.vec(16.0)) * glam::Mat4::from_scale(Vec3::splat(0.2 + rng.next()));
+                Sphere::new(to_world, false).unwrap()
+            })
+            .collect();
+        for kind in AccelKind::ALL {
+            let accel = Accel::build_kind(&tris, &spheres, *kind);
+            assert_eq!(accel.sphere_count(), 60);
+            let mut sphere_hits = 0;
+            for _ in 0..4000 {
+                let mut ray = Ray::new(rng.vec(16.0), rng.vec(2.0));
+                if rng.next() < 0.3 {
+                    ray.t_max = rng.next() * 10.0;
+                }
+                let triangle = brute_force(&tris, &ray);
+                let sphere = spheres
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(i, s)| Some((s.intersect(&ray)?, i)))
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                let expected = match (triangle, sphere) {
+                    (Some((tt, _)), Some((ts, i))) if ts < tt => Some(tris.len() as u32 + i as u32),
+                    (None, Some((_, i))) => Some(tris.len() as u32 + i as u32),
+                    (t, _) => t.map(|t| t.1),
+                };
+                let got = accel.intersect(&ray);
+                assert_eq!(expected, got.map(|h| h.primitive), "{kind:?}: ray {ray:?}");
+                assert_eq!(expected.is_some(), accel.occluded(&ray), "{kind:?}: ray {ray:?}");
+                let mut many = [None];
+                accel.intersect_many(&[ray], &mut many);
+                assert_eq!(many[0], got, "{kind:?}: batched");
+                sphere_hits += expected.is_some_and(|p| p >= tris.len() as u32) as u32;
+            }
+            assert!(sphere_hits > 300, "{kind:?}: only {sphere_hits} sphere hits");
+        }
+    }
+
+    #[test]
     fn accel_empty_scene_hits_nothing() {
-        let accel = Accel::build(&[]);
+        let accel = Accel::build(&[], &[]);
         let ray = Ray::new(Vec3::ZERO, Vec3::X);
         assert!(accel.intersect(&ray).is_none());
         assert!(!accel.occluded(&ray));
@@ -311,7 +382,7 @@ mod tests {
         ];
         for (kind, accel) in each_kind(&tris) {
             let hit = accel.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z)).expect("the real triangle");
-            assert_eq!(hit.triangle, 2, "{kind:?}");
+            assert_eq!(hit.primitive, 2, "{kind:?}");
             assert!((hit.t - 2.0).abs() < 1e-6, "{kind:?}");
             // A ray along the collapsed triangles hits nothing and produces no NaN.
             assert!(accel.intersect(&Ray::new(p - Vec3::X, Vec3::X)).is_none(), "{kind:?}");

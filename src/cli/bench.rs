@@ -136,7 +136,7 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         .iter()
         .map(|&kind| {
             let start = Instant::now();
-            let accel = Accel::build_kind(&tris, kind);
+            let accel = Accel::build_kind(&tris, &[], kind);
             (kind, accel, start.elapsed().as_secs_f64())
         })
         .collect();
@@ -157,7 +157,7 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         .enumerate()
         .filter_map(|(i, r)| {
             let hit = accel.intersect(r)?;
-            let [a, b, c] = tris[hit.triangle as usize];
+            let [a, b, c] = tris[hit.primitive as usize];
             let n = (b - a).cross(c - a).normalize();
             let n = if n.dot(r.d) > 0.0 { -n } else { n };
             let p = r.at(hit.t);
@@ -217,7 +217,7 @@ fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Re
     let s = scene.settings;
     let triangles = scene.geometry.all_triangle_positions();
     for &kind in AccelKind::ALL {
-        scene.accel = Accel::build_kind(&triangles, kind);
+        scene.accel = Accel::build_kind(&triangles, &scene.geometry.spheres, kind);
         let mut rates = Vec::new();
         for _ in 0..runs {
             let start = Instant::now();

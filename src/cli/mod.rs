@@ -88,7 +88,7 @@ enum Command {
         #[arg(short, long)]
         quiet: bool,
     },
-    /// Print what a scene contains: triangles, bounds, lights, memory.
+    /// Print what a scene contains: triangles, spheres, bounds, lights, memory.
     Info {
         /// Scene file (TOML).
         scene: PathBuf,
@@ -790,6 +790,7 @@ fn print_info(scene: &Scene) {
     );
     println!("shapes     {}", g.shapes.len());
     println!("triangles  {}", g.triangles.len());
+    println!("spheres    {}", g.spheres.len());
     println!("vertices   {}", g.positions.len());
     if b.is_empty() {
         println!("bounds     (empty)");
@@ -806,12 +807,13 @@ fn print_info(scene: &Scene) {
         Some(tessera::light::Environment::Constant(c)) => format!("constant {c}"),
         Some(tessera::light::Environment::Map(_)) => "equirectangular map".to_string(),
     };
-    let emissive = g.triangle_shape.iter().filter(|&&s| g.shapes[s as usize].light.is_some()).count();
+    let emits = |shapes: &[u32]| shapes.iter().filter(|&&s| g.shapes[s as usize].light.is_some()).count();
+    let (emissive, emissive_spheres) = (emits(&g.triangle_shape), emits(&g.sphere_shape));
     let l = &scene.lights;
     let spots = l.points.iter().filter(|p| p.spot.is_some()).count();
     let suns = l.distant.iter().filter(|d| !d.is_delta()).count();
     println!(
-        "lights     {} area ({emissive} triangles), {} point, {spots} spot, {} directional, {suns} sun; environment: {env}",
+        "lights     {} area ({emissive} triangles, {emissive_spheres} spheres), {} point, {spots} spot, {} directional, {suns} sun; environment: {env}",
         l.area.len(),
         l.points.len() - spots,
         l.distant.len() - suns

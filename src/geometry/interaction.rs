@@ -3,18 +3,18 @@
 use super::{Frame, Ray, RayDifferential};
 use glam::{Vec2, Vec3};
 
-/// A ray hit on a triangle, with its shading frame, texture coordinates and texture footprint.
+/// A ray hit on a surface, with its shading frame, texture coordinates and texture footprint.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceInteraction {
     /// Hit point.
     pub p: Vec3,
-    /// Geometric normal from the triangle's winding (counter-clockwise front), unit length.
+    /// Geometric normal on the front side (a triangle's counter-clockwise winding), unit length.
     pub ng: Vec3,
     /// Shading frame: interpolated normal, tangent along dp/du (DESIGN.md section 3).
     pub frame: Frame,
     /// Texture coordinates (bottom-left origin, v up).
     pub uv: Vec2,
-    /// Partial derivative of the position along u (from the triangle's UV Jacobian).
+    /// Partial derivative of the position along u (a triangle's from its UV Jacobian).
     pub dpdu: Vec3,
     /// Partial derivative of the position along v.
     pub dpdv: Vec3,
@@ -26,8 +26,27 @@ pub struct SurfaceInteraction {
     pub wo: Vec3,
     /// Distance along the ray (in units of the ray direction's length).
     pub t: f32,
-    /// Index of the triangle in the scene.
-    pub triangle: u32,
+    /// Index of the primitive in the scene: its triangles first, then its spheres
+    /// ([`crate::accel::Hit::primitive`]).
+    pub primitive: u32,
+}
+
+/// A point of a surface with its normals, texture coordinates and their derivatives: what a
+/// shape computes at a hit, for [`SurfaceInteraction::new`].
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    /// Position.
+    pub p: Vec3,
+    /// Geometric normal on the front side, unit length.
+    pub ng: Vec3,
+    /// Shading normal, unit length.
+    pub shading_normal: Vec3,
+    /// Texture coordinates (bottom-left origin, v up).
+    pub uv: Vec2,
+    /// dp/du.
+    pub dpdu: Vec3,
+    /// dp/dv.
+    pub dpdv: Vec3,
 }
 
 /// The vertex data of one triangle, as the mesh stores it.
@@ -78,10 +97,18 @@ impl SurfaceInteraction {
             .map(|[n0, n1, n2]| (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero())
             .filter(|n| *n != Vec3::ZERO)
             .unwrap_or(ng);
+        Self::new(SurfacePoint { p, ng, shading_normal: ns, uv, dpdu, dpdv }, ray, t, triangle)
+    }
+
+    /// The interaction at `point`, where `ray` met primitive `primitive` at parameter `t`: the
+    /// shading frame of DESIGN.md section 3 (the shading normal, the tangent along dp/du), no
+    /// footprint yet.
+    pub fn new(point: SurfacePoint, ray: &Ray, t: f32, primitive: u32) -> Self {
+        let SurfacePoint { p, ng, shading_normal, uv, dpdu, dpdv } = point;
         SurfaceInteraction {
             p,
             ng,
-            frame: Frame::from_normal_tangent(ns, dpdu),
+            frame: Frame::from_normal_tangent(shading_normal, dpdu),
             uv,
             dpdu,
             dpdv,
@@ -89,7 +116,7 @@ impl SurfaceInteraction {
             duv_dy: Vec2::ZERO,
             wo: -ray.d.normalize(),
             t,
-            triangle,
+            primitive,
         }
     }
 

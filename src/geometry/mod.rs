@@ -1,4 +1,4 @@
-//! Geometry: rays with differentials, shading frames, triangle meshes and the surface
+//! Geometry: rays with differentials, shading frames, triangle meshes, spheres and the surface
 //! interaction at a ray hit. Conventions (DESIGN.md section 3): right-handed world, y up;
 //! texture coordinates with the origin at the bottom-left, v up.
 
@@ -10,14 +10,16 @@ pub mod ply;
 mod quad_mesh;
 mod ray;
 pub mod shapes;
+mod sphere;
 mod subdivision;
 mod topology;
 
 pub use frame::Frame;
-pub use interaction::{SurfaceInteraction, TriangleVertices};
+pub use interaction::{SurfaceInteraction, SurfacePoint, TriangleVertices};
 pub use mesh::{Bounds, TriangleMesh};
 pub use quad_mesh::{QuadMesh, QuadMeshReport, load_quad_obj};
 pub use ray::{Ray, RayDifferential};
+pub use sphere::{Sphere, SphereSample};
 pub use subdivision::catmull_clark;
 pub use topology::Topology;
 

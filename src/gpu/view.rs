@@ -70,6 +70,12 @@ impl<'g> GpuView<'g> {
                 limits.max_texture_dimension_2d
             )));
         }
+        if !scene.geometry.spheres.is_empty() {
+            return Err(GpuError(format!(
+                "{} has exact spheres, which the GPU view does not rasterise: use uv_sphere meshes",
+                scene.path.display()
+            )));
+        }
         let (vertices, triangles) = view_geometry(&scene.geometry);
         if triangles.is_empty() {
             return Err(GpuError(format!("{} has no triangles to draw", scene.path.display())));

@@ -99,7 +99,7 @@ impl<'a> PathTracer<'a> {
                 break;
             };
             let mut si = scene.interaction(&ray, &hit);
-            let shape = scene.shape_of(si.triangle);
+            let shape = scene.shape_of(si.primitive);
 
             if let Some(light) = shape.light {
                 let emitted = lights.area[light as usize].emitted(si.ng, si.wo);
@@ -107,7 +107,7 @@ impl<'a> PathTracer<'a> {
                     let w = if prev.delta {
                         1.0
                     } else {
-                        power_heuristic(prev.pdf, lights.area_pdf(light as usize, prev.p, si.p, si.ng))
+                        power_heuristic(prev.pdf, lights.area_pdf(light as usize, prev.p, -si.wo, si.p, si.ng))
                     };
                     radiance += throughput * emitted * w;
                 }

@@ -77,7 +77,7 @@ pub fn primary_view(scene: &Scene, camera: &Camera, texture: &Texture) -> Primar
                         ctx.duv_dy.x,
                         ctx.duv_dy.y,
                     ]);
-                    triangle[x] = si.triangle + 1;
+                    triangle[x] = si.primitive + 1;
                 }
             }
         });

@@ -112,8 +112,9 @@ impl Lights {
     }
 
     /// Density with which [`Lights::sample`] reaches point `p_light` (geometric normal
-    /// `n_light`) of area light `light` from `p`.
-    pub fn area_pdf(&self, light: usize, p: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
-        self.area[light].pdf(p, p_light, n_light) * self.selection_pdf()
+    /// `n_light`) of area light `light` from `p`, where a path from `p` along the unit direction
+    /// `w` met it ([`AreaLight::pdf`]).
+    pub fn area_pdf(&self, light: usize, p: Vec3, w: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
+        self.area[light].pdf(p, w, p_light, n_light) * self.selection_pdf()
     }
 }

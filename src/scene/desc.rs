@@ -480,7 +480,7 @@ pub enum MaterialDesc {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeDesc {
-    /// `obj`, `ply`, `gltf`, `rectangle`, `cube` or `uv_sphere`.
+    /// `obj`, `ply`, `gltf`, `rectangle`, `cube`, `sphere` or `uv_sphere`.
     #[serde(rename = "type")]
     pub kind: ShapeKind,
     /// Mesh file (obj, ply, gltf).
@@ -489,6 +489,10 @@ pub struct ShapeDesc {
     pub segments: Option<u32>,
     /// Rings from pole to pole (uv_sphere, default 32).
     pub rings: Option<u32>,
+    /// Centre before the transform (sphere, default [0, 0, 0]).
+    pub center: Option<[f32; 3]>,
+    /// Radius before the transform (sphere, default 1).
+    pub radius: Option<f32>,
     /// Material name (default: diffuse 0.5; glTF files bring their own).
     pub material: Option<String>,
     /// Radiance emitted from the front side: makes the shape an area light.
@@ -521,7 +525,9 @@ pub enum ShapeKind {
     Rectangle,
     /// [-1, 1]^3.
     Cube,
-    /// The UV sphere of the Mitsuba test scenes.
+    /// The exact sphere (Mitsuba's `sphere`): `center`, `radius`, placed by the transform.
+    Sphere,
+    /// The UV sphere mesh of the Mitsuba test scenes.
     UvSphere,
 }
 

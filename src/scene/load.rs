@@ -13,7 +13,7 @@ use crate::camera::{Camera, CameraModel, FovAxis, Projection, ThinLens};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::read_text_bounded;
-use crate::geometry::{TriangleMesh, obj, ply, shapes};
+use crate::geometry::{Sphere, TriangleMesh, obj, ply, shapes};
 use crate::image::{ColorSpace, read_bitmap, read_bitmap_raw};
 use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::limits;
@@ -212,6 +212,24 @@ impl<'a> Loader<'a> {
                 Some(RgbValue(e)) if e.iter().any(|v| *v > 0.0) => Some(Rgb::from(e)),
                 _ => None,
             };
+            self.check_shape_keys(shape, &item)?;
+            if shape.kind == ShapeKind::Sphere {
+                let centre = Vec3::from(shape.center.unwrap_or([0.0; 3]));
+                let radius = shape.radius.unwrap_or(1.0);
+                if !(radius > 0.0) {
+                    return Err(self.error(format!("{item}.radius: {radius} is not positive")));
+                }
+                let to_world = transform * Mat4::from_translation(centre) * Mat4::from_scale(Vec3::splat(radius));
+                let sphere =
+                    Sphere::new(to_world, shape.flip_normals).map_err(|msg| self.error(format!("{item}: {msg}")))?;
+                let material = material_or_default(&mut default_material, &mut materials, assigned, emission.is_some());
+                let light = emission.map(|radiance| {
+                    lights.area.push(AreaLight::sphere(sphere.clone(), radiance));
+                    lights.area.len() as u32 - 1
+                });
+                geometry.add_sphere(sphere, item.clone(), material, light);
+                continue;
+            }
             let mut file_lights = Lights::default();
             for (mesh, material) in self.shape_meshes(shape, &item, &mut materials, &mut file_lights)? {
                 let mut mesh = mesh;
@@ -232,13 +250,12 @@ impl<'a> Loader<'a> {
                         cleanup.degenerate_triangles
                     ));
                 }
-                let material = match assigned.or(material) {
-                    Some(m) => m,
-                    None => *default_material[usize::from(emission.is_some())].get_or_insert_with(|| {
-                        materials.push(Material::default_diffuse(emission.is_some()));
-                        materials.len() as u32 - 1
-                    }),
-                };
+                let material = material_or_default(
+                    &mut default_material,
+                    &mut materials,
+                    assigned.or(material),
+                    emission.is_some(),
+                );
                 let light = emission.map(|radiance| {
                     let tris = (0..mesh.triangle_count()).map(|t| mesh.triangle(t)).collect();
                     lights.area.push(AreaLight::new(tris, radiance));
@@ -271,7 +288,7 @@ impl<'a> Loader<'a> {
             ));
         }
         let camera = self.camera(&desc.camera, &settings)?;
-        let accel = Accel::build(&geometry.all_triangle_positions());
+        let accel = Accel::build(&geometry.all_triangle_positions(), &geometry.spheres);
         Ok(Scene {
             path: self.path.to_path_buf(),
             settings,
@@ -984,15 +1001,8 @@ impl<'a> Loader<'a> {
         Ok(m)
     }
 
-    /// The meshes of a shape, each with the material it brings (glTF) if any; a glTF file's
-    /// punctual lights are added to `file_lights`, in the file's space.
-    fn shape_meshes(
-        &mut self,
-        shape: &ShapeDesc,
-        item: &str,
-        materials: &mut Vec<Material>,
-        file_lights: &mut Lights,
-    ) -> Result<Vec<(TriangleMesh, Option<u32>)>> {
+    /// Refuse keys that `shape`'s kind does not take, and a missing filename.
+    fn check_shape_keys(&self, shape: &ShapeDesc, item: &str) -> Result<()> {
         let needs_file = matches!(shape.kind, ShapeKind::Obj | ShapeKind::Ply | ShapeKind::Gltf);
         if needs_file != shape.filename.is_some() {
             return Err(self.error(if needs_file {
@@ -1004,9 +1014,24 @@ impl<'a> Loader<'a> {
         if shape.kind != ShapeKind::UvSphere && (shape.segments.is_some() || shape.rings.is_some()) {
             return Err(self.error(format!("{item}: segments and rings apply to uv_sphere only")));
         }
+        if shape.kind != ShapeKind::Sphere && (shape.center.is_some() || shape.radius.is_some()) {
+            return Err(self.error(format!("{item}: center and radius apply to sphere only")));
+        }
         if shape.kind != ShapeKind::Gltf && (shape.lights.is_some() || shape.light_scale.is_some()) {
             return Err(self.error(format!("{item}: lights and light_scale apply to gltf shapes only")));
         }
+        Ok(())
+    }
+
+    /// The meshes of a shape, each with the material it brings (glTF) if any; a glTF file's
+    /// punctual lights are added to `file_lights`, in the file's space.
+    fn shape_meshes(
+        &mut self,
+        shape: &ShapeDesc,
+        item: &str,
+        materials: &mut Vec<Material>,
+        file_lights: &mut Lights,
+    ) -> Result<Vec<(TriangleMesh, Option<u32>)>> {
         Ok(match shape.kind {
             ShapeKind::Obj => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
@@ -1036,6 +1061,7 @@ impl<'a> Loader<'a> {
                     .extend(import.warnings.into_iter().map(|w| format!("{}: {item}: {w}", self.path.display())));
                 import.meshes
             }
+            ShapeKind::Sphere => unreachable!("spheres are not meshes"),
             ShapeKind::Rectangle => vec![(shapes::rectangle(), None)],
             ShapeKind::Cube => vec![(shapes::cube(), None)],
             ShapeKind::UvSphere => {
@@ -1154,6 +1180,22 @@ pub(super) fn mitsuba_look_at(origin: Vec3, target: Vec3, up: Vec3) -> Option<Ma
 }
 
 /// The scene-file name of a blending operator.
+/// The material a shape renders with: its own (`chosen`), or the scene's default for plain
+/// shapes or for emitters, made the first time one is needed (`defaults` holds them).
+fn material_or_default(
+    defaults: &mut [Option<u32>; 2],
+    materials: &mut Vec<Material>,
+    chosen: Option<u32>,
+    emits: bool,
+) -> u32 {
+    chosen.unwrap_or_else(|| {
+        *defaults[usize::from(emits)].get_or_insert_with(|| {
+            materials.push(Material::default_diffuse(emits));
+            materials.len() as u32 - 1
+        })
+    })
+}
+
 fn blend_name(kind: BlendKind) -> &'static str {
     match kind {
         BlendKind::Linear => "linear",

@@ -30,7 +30,7 @@ use crate::camera::{FovAxis, Projection};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::StagedFolder;
-use crate::geometry::Frame;
+use crate::geometry::{Frame, Sphere};
 use crate::image::write_exr;
 use crate::light::{Environment, SpotFalloff};
 use crate::limits;
@@ -57,6 +57,12 @@ fn xml_escape(s: &str) -> String {
 
 fn rgb_value(c: Rgb) -> String {
     format!("{}, {}, {}", c.x, c.y, c.z)
+}
+
+/// A `to_world` transform element of matrix `m`.
+fn to_world_element(m: Mat4) -> String {
+    let rows = m.transpose().to_cols_array().map(|v| v.to_string()).join(" ");
+    format!("<transform name=\"to_world\"><matrix value=\"{rows}\"/></transform>")
 }
 
 /// How a texture is baked: as a colour (RGB times a factor) or a scalar (a channel times a factor).
@@ -376,6 +382,18 @@ impl Exporter<'_> {
         Ok(file)
     }
 
+    /// The opening of a Mitsuba `sphere` shape: the unit sphere under the sphere's transform.
+    fn sphere(&mut self, sphere: &Sphere, name: &str) -> String {
+        let m = sphere.to_world();
+        if m.determinant() < 0.0 {
+            self.out.warnings.push(format!(
+                "{name}: the sphere's transform mirrors it; Mitsuba may turn a mirrored sphere inside out"
+            ));
+        }
+        let flip = if sphere.flip_normals() { "<boolean name=\"flip_normals\" value=\"true\"/>" } else { "" };
+        format!("<shape type=\"sphere\">{}{flip}", to_world_element(m))
+    }
+
     /// The camera as Mitsuba's `perspective`, `thinlens` or `orthographic` sensor.
     fn sensor(&self) -> String {
         let s = &self.scene.settings;
@@ -413,11 +431,11 @@ impl Exporter<'_> {
                 ("orthographic", String::new())
             }
         };
-        let rows = m.transpose().to_cols_array().map(|v| v.to_string()).join(" ");
+        let to_world = to_world_element(m);
         format!(
             "<sensor type=\"{kind}\">{params}\
              <float name=\"near_clip\" value=\"{near_clip}\"/><float name=\"far_clip\" value=\"10000000\"/>\
-             <transform name=\"to_world\"><matrix value=\"{rows}\"/></transform>\
+             {to_world}\
              <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{}\"/><integer name=\"seed\" value=\"{}\"/></sampler>\
              <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/>\
              <string name=\"pixel_format\" value=\"rgb\"/><string name=\"component_format\" value=\"float32\"/>\
@@ -549,16 +567,15 @@ pub fn export_mitsuba(scene: &Scene, dir: &Path, bake_res: usize) -> Result<Mits
         let _ = writeln!(xml, "{bsdf}");
     }
     for (i, shape) in scene.geometry.shapes.iter().enumerate() {
-        let file = ex.mesh(i)?;
+        let surface = match shape.sphere {
+            Some(s) => ex.sphere(&scene.geometry.spheres[s as usize], &shape.name),
+            None => format!("<shape type=\"obj\"><string name=\"filename\" value=\"{}\"/>", ex.mesh(i)?),
+        };
         let emitter = shape.light.map_or(String::new(), |l| {
             let radiance = scene.lights.area[l as usize].radiance;
             format!("<emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>", rgb_value(radiance))
         });
-        let _ = writeln!(
-            xml,
-            "<shape type=\"obj\"><string name=\"filename\" value=\"{file}\"/><ref id=\"material{}\"/>{emitter}</shape>",
-            shape.material
-        );
+        let _ = writeln!(xml, "{surface}<ref id=\"material{}\"/>{emitter}</shape>", shape.material);
     }
     let punctual = ex.punctual_emitters();
     let env = ex.environment()?;

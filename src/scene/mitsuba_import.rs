@@ -3,7 +3,7 @@
 //!
 //! Translated: `<default>` parameters (`$name`); the `path` integrator; `perspective`,
 //! `thinlens` and `orthographic` sensors with their film and sampler; `obj`, `ply`, `rectangle`
-//! and `cube` shapes (and `sphere`, as a fine UV-sphere mesh); transforms; the BSDFs tessera has
+//! `cube` and `sphere` shapes; transforms; the BSDFs tessera has
 //! (`diffuse`, `conductor`, `roughconductor`, `dielectric`, `roughdielectric`, `roughplastic`,
 //! wrapped in `twosided` and `normalmap`), `bitmap` textures and `<ref>`s to them; `area`,
 //! `point`, `spot`, `directional`, `constant` and `envmap` emitters. Each item that is not
@@ -17,6 +17,7 @@
 use super::load::mitsuba_look_at;
 use crate::error::{Error, Result};
 use crate::files::read_text_bounded;
+use crate::geometry::Sphere;
 use crate::limits;
 use glam::{Mat4, Vec3, Vec4};
 use std::collections::HashMap;
@@ -637,20 +638,25 @@ impl Importer {
                 shape.insert("type".into(), kind.into());
             }
             "sphere" => {
-                shape.insert("type".into(), "uv_sphere".into());
-                shape.insert("segments".into(), Value::Integer(512));
-                shape.insert("rings".into(), Value::Integer(256));
                 let center = self.vector(node, "center")?.unwrap_or(Vec3::ZERO);
                 let radius = self.float(node, "radius")?.unwrap_or(1.0);
-                // tessera's UV sphere has its poles on y, Mitsuba's sphere on z.
-                let local = Mat4::from_translation(center)
-                    * Mat4::from_scale(Vec3::splat(radius))
-                    * Mat4::from_axis_angle(Vec3::X, std::f32::consts::FRAC_PI_2);
-                m *= local;
-                self.skip(format!(
-                    "{}: the analytic sphere is rendered as a 512 x 256 UV-sphere mesh (its uv are not Mitsuba's)",
-                    at(node)
-                ));
+                let local = Mat4::from_translation(center) * Mat4::from_scale(Vec3::splat(radius));
+                if Sphere::new(m * local, false).is_ok() {
+                    shape.insert("type".into(), "sphere".into());
+                    shape.insert("center".into(), floats(&center.to_array()));
+                    shape.insert("radius".into(), num(radius));
+                } else {
+                    // tessera's UV sphere has its poles on y, Mitsuba's sphere on z.
+                    shape.insert("type".into(), "uv_sphere".into());
+                    shape.insert("segments".into(), Value::Integer(512));
+                    shape.insert("rings".into(), Value::Integer(256));
+                    m *= local * Mat4::from_axis_angle(Vec3::X, std::f32::consts::FRAC_PI_2);
+                    self.skip(format!(
+                        "{}: a sphere whose to_world is not a similarity is rendered as a 512 x 256 \
+                         ellipsoid mesh (Mitsuba renders a sphere)",
+                        at(node)
+                    ));
+                }
             }
             other => {
                 self.skip(format!("{}: shape type '{other}' is not translated (left out)", at(node)));

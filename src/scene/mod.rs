@@ -31,7 +31,7 @@ pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Opti
 
 use crate::accel::{Accel, Hit};
 use crate::camera::Camera;
-use crate::geometry::{Bounds, Ray, SurfaceInteraction, TriangleMesh, TriangleVertices};
+use crate::geometry::{Bounds, Ray, Sphere, SurfaceInteraction, TriangleMesh, TriangleVertices};
 use crate::light::Lights;
 use crate::material::Material;
 use crate::texture::Texture;
@@ -64,15 +64,17 @@ pub struct Shape {
     pub material: u32,
     /// Index into the area lights, if the shape emits.
     pub light: Option<u32>,
-    /// First vertex in [`Geometry`]'s arrays.
+    /// First vertex in [`Geometry`]'s arrays (for a sphere, where the next mesh's will be).
     pub first_vertex: u32,
+    /// Index into [`Geometry::spheres`] when the shape is an exact sphere (it has no vertices).
+    pub sphere: Option<u32>,
     /// Whether the mesh had normals and texture coordinates.
     pub has_normals: bool,
     /// See `has_normals`.
     pub has_uvs: bool,
 }
 
-/// All triangles of a scene in world space, in one set of arrays.
+/// All triangles of a scene in world space, in one set of arrays, and its exact spheres.
 #[derive(Clone, Debug, Default)]
 pub struct Geometry {
     /// Vertex positions.
@@ -85,6 +87,10 @@ pub struct Geometry {
     pub triangles: Vec<[u32; 3]>,
     /// Shape of each triangle.
     pub triangle_shape: Vec<u32>,
+    /// Exact spheres (primitives after the triangles: [`crate::accel::Hit::primitive`]).
+    pub spheres: Vec<Sphere>,
+    /// Shape of each sphere.
+    pub sphere_shape: Vec<u32>,
     /// Shapes.
     pub shapes: Vec<Shape>,
 }
@@ -100,6 +106,7 @@ impl Geometry {
             material,
             light,
             first_vertex: first,
+            sphere: None,
             has_normals: mesh.normals.is_some(),
             has_uvs: mesh.uvs.is_some(),
         });
@@ -108,6 +115,22 @@ impl Geometry {
         self.uvs.extend(mesh.uvs.unwrap_or_else(|| vec![Vec2::ZERO; n]));
         self.triangles.extend(mesh.indices.iter().map(|t| t.map(|i| i + first)));
         self.triangle_shape.extend(std::iter::repeat_n(shape, mesh.indices.len()));
+    }
+
+    /// Append an exact sphere as a new shape.
+    pub fn add_sphere(&mut self, sphere: Sphere, name: String, material: u32, light: Option<u32>) {
+        let shape = self.shapes.len() as u32;
+        self.shapes.push(Shape {
+            name,
+            material,
+            light,
+            first_vertex: self.positions.len() as u32,
+            sphere: Some(self.spheres.len() as u32),
+            has_normals: true,
+            has_uvs: true,
+        });
+        self.spheres.push(sphere);
+        self.sphere_shape.push(shape);
     }
 
     /// Vertex positions of triangle `i`.
@@ -133,13 +156,13 @@ impl Geometry {
         }
     }
 
-    /// Bounding box of all vertices.
+    /// Bounding box of all vertices and spheres.
     pub fn bounds(&self) -> Bounds {
         let mut b = Bounds::EMPTY;
         for p in &self.positions {
             b.include(*p);
         }
-        b
+        self.spheres.iter().fold(b, |b, s| b.union(s.bounds()))
     }
 }
 
@@ -182,14 +205,25 @@ impl Scene {
 
     /// The surface that `ray` meets at `hit` (an answer of [`Scene::accel`] for `ray`).
     pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
-        let tri = self.geometry.triangle_vertices(hit.triangle as usize);
-        SurfaceInteraction::from_triangle(&tri, hit.b1, hit.b2, hit.t, ray, hit.triangle)
+        let g = &self.geometry;
+        match (hit.primitive as usize).checked_sub(g.triangles.len()) {
+            Some(sphere) => g.spheres[sphere].interaction(ray, hit.t, hit.primitive),
+            None => {
+                let tri = g.triangle_vertices(hit.primitive as usize);
+                SurfaceInteraction::from_triangle(&tri, hit.b1, hit.b2, hit.t, ray, hit.primitive)
+            }
+        }
     }
 
-    /// The shape a triangle belongs to.
+    /// The shape a primitive (a triangle or a sphere: [`Hit::primitive`]) belongs to.
     #[inline]
-    pub fn shape_of(&self, triangle: u32) -> &Shape {
-        &self.geometry.shapes[self.geometry.triangle_shape[triangle as usize] as usize]
+    pub fn shape_of(&self, primitive: u32) -> &Shape {
+        let g = &self.geometry;
+        let shape = match (primitive as usize).checked_sub(g.triangles.len()) {
+            Some(sphere) => g.sphere_shape[sphere],
+            None => g.triangle_shape[primitive as usize],
+        };
+        &g.shapes[shape as usize]
     }
 
     /// Approximate memory held by geometry, acceleration structure and textures, in bytes.
