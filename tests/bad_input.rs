@@ -102,6 +102,41 @@ fn malformed_ply_is_an_error_naming_the_file() {
 }
 
 #[test]
+fn malformed_serialized_is_an_error_naming_the_file() {
+    use std::io::Write;
+    let scene = |file: &str, index: u32| {
+        format!("{CAMERA}[[shapes]]\ntype = \"serialized\"\nfilename = \"{file}\"\nshape_index = {index}\n")
+    };
+    let zlib = |body: &[u8]| {
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(body).unwrap();
+        z.finish().unwrap()
+    };
+    let header = |version: u16| [0x041Cu16.to_le_bytes(), version.to_le_bytes()].concat();
+    // A header claiming 30 million triangles over a stream of a few bytes: an error, and no
+    // allocation for them.
+    let mut claims = 0x1000u32.to_le_bytes().to_vec();
+    claims.extend(b"big\0");
+    claims.extend(3u64.to_le_bytes());
+    claims.extend(30_000_000u64.to_le_bytes());
+    let lying = [header(4), zlib(&claims)].concat();
+    error_of(&scene("lying.serialized", 0), &[("lying.serialized", &lying)], &["lying.serialized", "truncated"]);
+    error_of(&scene("text.serialized", 0), &[("text.serialized", b"solid cube\n")], &["text.serialized", "magic"]);
+    let v5 = [header(5), zlib(&claims)].concat();
+    error_of(&scene("v5.serialized", 0), &[("v5.serialized", &v5)], &["v5.serialized", "version 5"]);
+    let mut one = lying.clone();
+    one.extend(0u64.to_le_bytes());
+    one.extend(1u32.to_le_bytes());
+    error_of(
+        &scene("one.serialized", 3),
+        &[("one.serialized", &one)],
+        &["one.serialized", "shape_index 3", "1 meshes"],
+    );
+    let garbage = [header(4), vec![0x78, 0x9c, 1, 2, 3]].concat();
+    error_of(&scene("bad.serialized", 0), &[("bad.serialized", &garbage)], &["bad.serialized", "corrupt"]);
+}
+
+#[test]
 fn zero_area_triangles_are_dropped_with_a_warning() {
     let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\nf 1 1 2\n";
     let dir = scene_dir(&obj_scene("some.obj"), &[("some.obj", obj)]);

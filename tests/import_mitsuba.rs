@@ -49,8 +49,8 @@ fn golden_scenes_round_trip_through_mitsuba_xml() {
 /// A scene in Mitsuba's own idioms: `$` defaults, a `<ref>`-erenced texture and BSDF, a
 /// `twosided` wrapper, a sensor whose field of view spans x by default and whose near clip is
 /// Mitsuba's default, a spot light placed by `lookat`, an exact sphere, a PLY mesh, and things
-/// tessera does not have (a serialized shape, a Gaussian filter, a `principled` BSDF, a sphere
-/// scaled unevenly), each listed.
+/// tessera does not have (a Gaussian filter, a `principled` BSDF, a sphere scaled unevenly), each
+/// listed; a serialized file's second mesh.
 #[test]
 fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let xml = r#"<scene version="3.0.0">
@@ -70,7 +70,7 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         <shape type="sphere"><point name="center" x="0" y="1" z="0"/><float name="radius" value="0.8"/><ref id="gold"/></shape>
         <shape type="sphere"><transform name="to_world"><scale x="0.2" y="0.4" z="0.2"/><translate x="2"/></transform></shape>
         <shape type="ply"><string name="filename" value="quad.ply"/></shape>
-        <shape type="serialized"><string name="filename" value="bunny.serialized"/></shape>
+        <shape type="serialized"><string name="filename" value="quads.serialized"/><integer name="shape_index" value="1"/></shape>
         <shape type="cube"><bsdf type="principled"/></shape>
         <emitter type="spot">
             <transform name="to_world"><lookat origin="2, 4, 2" target="0, 0, 0"/></transform>
@@ -78,12 +78,16 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         </emitter>
         <emitter type="constant"><rgb name="radiance" value="0.1"/></emitter>
     </scene>"#;
-    let files: [(&str, &[u8]); 3] =
-        [("scene.xml", xml.as_bytes()), ("checker.png", &checker_png()), ("quad.ply", QUAD_PLY.as_bytes())];
+    let files: [(&str, &[u8]); 4] = [
+        ("scene.xml", xml.as_bytes()),
+        ("checker.png", &checker_png()),
+        ("quad.ply", QUAD_PLY.as_bytes()),
+        ("quads.serialized", &quads_serialized()),
+    ];
     let dir = common::scene_dir("", &files);
     let import = import_mitsuba(&dir.path().join("scene.xml"), dir.path()).unwrap();
     let gaps = import.untranslated.join("\n");
-    for expected in ["type=\"serialized\"", "gaussian", "principled", "ellipsoid", "Beckmann"] {
+    for expected in ["gaussian", "principled", "ellipsoid", "Beckmann"] {
         assert!(gaps.contains(expected), "{expected} should be listed:\n{gaps}");
     }
     let path = dir.path().join("imported.toml");
@@ -108,7 +112,13 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let spot = &scene.lights.points[0];
     assert!(spot.spot.unwrap().axis().distance(-glam::Vec3::new(2.0, 4.0, 2.0).normalize()) < 1e-5);
     assert!(scene.materials.iter().any(|m| m.name == "materials.floor" && m.two_sided));
-    assert_eq!(scene.geometry.shapes.len(), 5, "rectangle, 2 spheres, PLY, cube (the serialized shape is left out)");
+    assert_eq!(scene.geometry.shapes.len(), 6, "rectangle, 2 spheres, PLY, serialized, cube");
+    // The serialized file's second mesh: the quad moved by x + 3, double precision.
+    let g = &scene.geometry;
+    let i = g.shapes.iter().position(|s| s.name.contains("quads.serialized")).unwrap();
+    let vertices = &g.positions[g.shapes[i].first_vertex as usize..g.shapes[i + 1].first_vertex as usize];
+    assert_eq!(vertices.iter().map(|p| p.x).fold(f32::MIN, f32::max), 4.0);
+    assert!(!g.shapes[i].has_normals && g.shapes[i].has_uvs);
     // The sphere is exact; the unevenly scaled one a mesh.
     let [sphere] = &scene.geometry.spheres[..] else { panic!("one exact sphere") };
     assert_eq!((sphere.center(), sphere.radius()), (glam::Vec3::Y, 0.8));
@@ -187,29 +197,72 @@ const QUAD_PLY: &str = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float 
     property float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\n\
     end_header\n-1 -1 0 0 0\n1 -1 0 1 0\n1 1 0 1 1\n-1 1 0 0 1\n4 0 1 2 3\n";
 
-/// PLY texture coordinates are read as Mitsuba 3.9.1 reads them. Rendered there, a quad as PLY
-/// and the same quad as OBJ (the same u, v per vertex) show the texture mirrored top to bottom
-/// (Mitsuba flips an OBJ's v, not a PLY's), so tessera's PLY uv must be the OBJ's (u, 1 - v):
-/// checked pixel by pixel on the uv AOV, same samples on both sides.
+/// A Mitsuba serialized file (format version 4) of two meshes: `QUAD_PLY`'s quad with normals
+/// in single precision, and the same moved by x + 3, without normals, in double precision.
+fn quads_serialized() -> Vec<u8> {
+    use std::io::Write;
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    let mesh = |name: &str, dx: f64, double: bool| {
+        let mut body = Vec::new();
+        let flags: u32 = if double { 0x2000 | 0x0002 } else { 0x1000 | 0x0002 | 0x0001 };
+        body.extend(flags.to_le_bytes());
+        body.extend(name.as_bytes());
+        body.push(0);
+        body.extend(4u64.to_le_bytes());
+        body.extend(2u64.to_le_bytes());
+        let mut floats = |values: &[f64]| {
+            for v in values {
+                if double { body.extend(v.to_le_bytes()) } else { body.extend((*v as f32).to_le_bytes()) }
+            }
+        };
+        corners.iter().for_each(|(x, y)| floats(&[x + dx, *y, 0.0]));
+        if !double {
+            corners.iter().for_each(|_| floats(&[0.0, 0.0, 1.0]));
+        }
+        corners.iter().for_each(|(x, y)| floats(&[(x + 1.0) / 2.0, (y + 1.0) / 2.0]));
+        for i in [0u32, 1, 2, 0, 2, 3] {
+            body.extend(i.to_le_bytes());
+        }
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        z.write_all(&body).unwrap();
+        [&0x041Cu16.to_le_bytes()[..], &4u16.to_le_bytes(), &z.finish().unwrap()].concat()
+    };
+    let (first, second) = (mesh("quad", 0.0, false), mesh("moved", 3.0, true));
+    let mut file = [first.clone(), second].concat();
+    file.extend(0u64.to_le_bytes());
+    file.extend((first.len() as u64).to_le_bytes());
+    file.extend(2u32.to_le_bytes());
+    file
+}
+
+/// PLY and serialized texture coordinates are read as Mitsuba 3.9.1 reads them. Rendered
+/// there, a quad as PLY or serialized and the same quad as OBJ (the same u, v per vertex) show
+/// the texture mirrored top to bottom (Mitsuba flips an OBJ's v, not the others'), so tessera's
+/// uv must be the OBJ's (u, 1 - v): checked pixel by pixel on the uv AOV, same samples on both
+/// sides.
 #[test]
-fn ply_texture_coordinates_run_as_mitsuba_reads_them() {
+fn ply_and_serialized_texture_coordinates_run_as_mitsuba_reads_them() {
     let obj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
     let scene = |file: &str| {
         format!(
             "[render]\nwidth = 16\nheight = 16\nspp = 2\n[camera]\nprojection = \"orthographic\"\nextent = 1.5\n\
              eye = [0, 0, 3]\ntarget = [0, 0, 0]\n[environment]\ntype = \"constant\"\nradiance = 1\n\
              [[shapes]]\ntype = \"{}\"\nfilename = \"{file}\"\n",
-            &file[file.len() - 3..]
+            file.rsplit('.').next().unwrap()
         )
     };
     let uv = |file: &str| {
-        let files: [(&str, &[u8]); 2] = [("quad.ply", QUAD_PLY.as_bytes()), ("quad.obj", obj.as_bytes())];
+        let serialized = quads_serialized();
+        let files: [(&str, &[u8]); 3] =
+            [("quad.ply", QUAD_PLY.as_bytes()), ("quad.obj", obj.as_bytes()), ("quad.serialized", &serialized)];
         let (_dir, scene) = common::scene(&scene(file), &files);
         let film = tessera::integrator::render(&scene, None, &[tessera::image::Aov::Uv], &|_, _| {});
         film.aov(tessera::image::Aov::Uv).unwrap()
     };
-    let (from_ply, from_obj) = (uv("quad.ply"), uv("quad.obj"));
-    for (p, o) in from_ply.data.chunks(2).zip(from_obj.data.chunks(2)) {
-        assert!((p[0] - o[0]).abs() < 1e-6 && (p[1] - (1.0 - o[1])).abs() < 1e-6, "PLY {p:?} against OBJ {o:?}");
+    let from_obj = uv("quad.obj");
+    for file in ["quad.ply", "quad.serialized"] {
+        for (p, o) in uv(file).data.chunks(2).zip(from_obj.data.chunks(2)) {
+            assert!((p[0] - o[0]).abs() < 1e-6 && (p[1] - (1.0 - o[1])).abs() < 1e-6, "{file} {p:?} against OBJ {o:?}");
+        }
     }
 }

@@ -9,6 +9,7 @@ pub mod obj;
 pub mod ply;
 mod quad_mesh;
 mod ray;
+pub mod serialized;
 pub mod shapes;
 mod sphere;
 mod subdivision;

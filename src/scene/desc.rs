@@ -480,11 +480,13 @@ pub enum MaterialDesc {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShapeDesc {
-    /// `obj`, `ply`, `gltf`, `rectangle`, `cube`, `sphere` or `uv_sphere`.
+    /// `obj`, `ply`, `serialized`, `gltf`, `rectangle`, `cube`, `sphere` or `uv_sphere`.
     #[serde(rename = "type")]
     pub kind: ShapeKind,
-    /// Mesh file (obj, ply, gltf).
+    /// Mesh file (obj, ply, serialized, gltf).
     pub filename: Option<String>,
+    /// Which mesh of a serialized file (default 0).
+    pub shape_index: Option<u32>,
     /// Segments around the axis (uv_sphere, default 64).
     pub segments: Option<u32>,
     /// Rings from pole to pole (uv_sphere, default 32).
@@ -519,6 +521,8 @@ pub enum ShapeKind {
     Obj,
     /// Stanford PLY file (ASCII or binary), read as Mitsuba 3 reads it.
     Ply,
+    /// Mitsuba's serialized mesh file (format versions 3 and 4).
+    Serialized,
     /// glTF 2.0 file (.gltf or .glb): meshes, node transforms and materials.
     Gltf,
     /// [-1, 1]^2 in z = 0, facing +z.

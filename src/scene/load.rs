@@ -13,7 +13,7 @@ use crate::camera::{Camera, CameraModel, FovAxis, Projection, ThinLens};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::read_text_bounded;
-use crate::geometry::{Sphere, TriangleMesh, obj, ply, shapes};
+use crate::geometry::{Sphere, TriangleMesh, obj, ply, serialized, shapes};
 use crate::image::{ColorSpace, read_bitmap, read_bitmap_raw};
 use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::limits;
@@ -1003,13 +1003,17 @@ impl<'a> Loader<'a> {
 
     /// Refuse keys that `shape`'s kind does not take, and a missing filename.
     fn check_shape_keys(&self, shape: &ShapeDesc, item: &str) -> Result<()> {
-        let needs_file = matches!(shape.kind, ShapeKind::Obj | ShapeKind::Ply | ShapeKind::Gltf);
+        let needs_file =
+            matches!(shape.kind, ShapeKind::Obj | ShapeKind::Ply | ShapeKind::Serialized | ShapeKind::Gltf);
         if needs_file != shape.filename.is_some() {
             return Err(self.error(if needs_file {
                 format!("{item}: a {:?} shape needs a filename", shape.kind).to_lowercase()
             } else {
-                format!("{item}: only obj, ply and gltf shapes take a filename")
+                format!("{item}: only obj, ply, serialized and gltf shapes take a filename")
             }));
+        }
+        if shape.kind != ShapeKind::Serialized && shape.shape_index.is_some() {
+            return Err(self.error(format!("{item}: shape_index applies to serialized only")));
         }
         if shape.kind != ShapeKind::UvSphere && (shape.segments.is_some() || shape.rings.is_some()) {
             return Err(self.error(format!("{item}: segments and rings apply to uv_sphere only")));
@@ -1040,6 +1044,11 @@ impl<'a> Loader<'a> {
             ShapeKind::Ply => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
                 vec![(ply::load_ply(&file).map_err(|e| e.in_scene(self.path, item))?, None)]
+            }
+            ShapeKind::Serialized => {
+                let file = self.resolve_path(shape.filename.as_deref().expect("checked"));
+                let mesh = serialized::load_serialized(&file, shape.shape_index.unwrap_or(0));
+                vec![(mesh.map_err(|e| e.in_scene(self.path, item))?, None)]
             }
             ShapeKind::Gltf => {
                 let file = self.resolve_path(shape.filename.as_deref().expect("checked"));

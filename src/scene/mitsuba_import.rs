@@ -2,8 +2,8 @@
 //! Mitsuba does, translated into a scene file, and a list of everything that was not.
 //!
 //! Translated: `<default>` parameters (`$name`); the `path` integrator; `perspective`,
-//! `thinlens` and `orthographic` sensors with their film and sampler; `obj`, `ply`, `rectangle`
-//! `cube` and `sphere` shapes; transforms; the BSDFs tessera has
+//! `thinlens` and `orthographic` sensors with their film and sampler; `obj`, `ply`, `rectangle`,
+//! `cube`, `sphere` and `serialized` shapes; transforms; the BSDFs tessera has
 //! (`diffuse`, `conductor`, `roughconductor`, `dielectric`, `roughdielectric`, `roughplastic`,
 //! wrapped in `twosided` and `normalmap`), `bitmap` textures and `<ref>`s to them; `area`,
 //! `point`, `spot`, `directional`, `constant` and `envmap` emitters. Each item that is not
@@ -152,6 +152,12 @@ impl Importer {
         let Some(p) = self.property(node, name) else { return Ok(None) };
         let value = self.attr(p, "value").ok_or_else(|| format!("{}: {name} has no value", at(node)))?;
         value.trim().parse::<f32>().map(Some).map_err(|_| format!("{}: {name} = '{value}' is not a number", at(node)))
+    }
+
+    fn integer(&self, node: Node, name: &str) -> Parsed<Option<i64>> {
+        self.string(node, name)
+            .map(|v| v.trim().parse::<i64>().map_err(|_| format!("{}: {name} = '{v}' is not an integer", at(node))))
+            .transpose()
     }
 
     fn string(&self, node: Node, name: &str) -> Option<String> {
@@ -369,12 +375,7 @@ impl Importer {
                 self.skip(format!("{}: rendered as tessera's path tracer", at(node)));
             }
         }
-        let depth = |this: &Self, name: &str| -> Parsed<Option<i64>> {
-            this.string(node, name)
-                .map(|v| v.trim().parse::<i64>().map_err(|_| format!("{}: {name} = '{v}'", at(node))))
-                .transpose()
-        };
-        let (max_depth, rr_depth) = (depth(self, "max_depth")?, depth(self, "rr_depth")?);
+        let (max_depth, rr_depth) = (self.integer(node, "max_depth")?, self.integer(node, "rr_depth")?);
         let render = self.render_table();
         render.insert("max_depth".into(), Value::Integer(max_depth.unwrap_or(-1)));
         if let Some(rr) = rr_depth {
@@ -626,10 +627,13 @@ impl Importer {
         let mut shape = Table::new();
         let mut m = self.to_world(node)?.unwrap_or(Mat4::IDENTITY);
         match kind {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 shape.insert("type".into(), kind.into());
                 let f = self.string(node, "filename").ok_or_else(|| format!("{}: no filename", at(node)))?;
                 shape.insert("filename".into(), self.file(&f).into());
+                if let Some(index) = self.integer(node, "shape_index")?.filter(|_| kind == "serialized") {
+                    shape.insert("shape_index".into(), Value::Integer(index));
+                }
                 if self.boolean(node, "face_normals") {
                     self.skip(format!("{}: face_normals = true: the file's vertex normals are used", at(node)));
                 }

@@ -13,7 +13,8 @@ pub use load::{SceneOverrides, load_scene, load_scene_str, load_texture};
 pub use mitsuba::{MitsubaExport, export_mitsuba};
 pub use mitsuba_import::{MitsubaImport, import_mitsuba};
 
-/// One mesh file's surface, by extension: OBJ (no tangents), or glTF 2.0 (.gltf, .glb: every
+/// One mesh file's surface, by extension: OBJ, PLY or Mitsuba's serialized (its first mesh; no
+/// tangents), or glTF 2.0 (.gltf, .glb: every
 /// triangle primitive in world space, with per-vertex tangents where every primitive has
 /// TANGENT). For `tessera deform`, which needs the surface and its UVs, not a scene; checked as
 /// [`TriangleMesh::check`] does (degenerate triangles are kept: `deform` counts them).
@@ -23,7 +24,13 @@ pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Opti
         Some("gltf" | "glb") => gltf::import_surface(path)?,
         Some("obj") => (crate::geometry::obj::load_obj(path)?, None),
         Some("ply") => (crate::geometry::ply::load_ply(path)?, None),
-        _ => return Err(crate::Error::mesh(path, "expected a mesh file ending in .obj, .ply, .gltf or .glb")),
+        Some("serialized") => (crate::geometry::serialized::load_serialized(path, 0)?, None),
+        _ => {
+            return Err(crate::Error::mesh(
+                path,
+                "expected a mesh file ending in .obj, .ply, .serialized, .gltf or .glb",
+            ));
+        }
     };
     mesh.check().map_err(|msg| crate::Error::mesh(path, msg))?;
     Ok((mesh, tangents))
