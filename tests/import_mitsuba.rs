@@ -46,7 +46,7 @@ fn golden_scenes_round_trip_through_mitsuba_xml() {
     }
 }
 
-/// A scene in Mitsuba's own idioms: `$` defaults, a `<ref>`-erenced texture and BSDF, a
+/// A scene in Mitsuba's own idioms: `$` defaults (also in a `type`), a `<ref>`-erenced texture and BSDF, a
 /// `twosided` wrapper, a sensor whose field of view spans x by default and whose near clip is
 /// Mitsuba's default, a spot light placed by `lookat`, an exact sphere, a PLY mesh, and things
 /// tessera does not have (a Gaussian filter, a `principled` BSDF, a sphere scaled unevenly), each
@@ -56,7 +56,8 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let xml = r#"<scene version="3.0.0">
         <default name="spp" value="32"/>
         <default name="res" value="64"/>
-        <integrator type="path"><integer name="max_depth" value="6"/></integrator>
+        <default name="integrator" value="path"/>
+        <integrator type="$integrator"><integer name="max_depth" value="6"/></integrator>
         <sensor type="perspective">
             <float name="fov" value="45"/>
             <transform name="to_world"><lookat origin="0, 2, 6" target="0, 0, 0" up="0, 1, 0"/></transform>
@@ -90,6 +91,8 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     for expected in ["gaussian", "principled", "ellipsoid", "Beckmann"] {
         assert!(gaps.contains(expected), "{expected} should be listed:\n{gaps}");
     }
+    // Defaults apply in every attribute: `type="$integrator"` is the path tracer.
+    assert!(!gaps.contains("integrator"), "{gaps}");
     let path = dir.path().join("imported.toml");
     std::fs::write(&path, import.to_toml(&dir.path().join("scene.xml"))).unwrap();
     let scene = load_scene(&path, &SceneOverrides::default()).unwrap_or_else(|e| panic!("{e}"));

@@ -204,25 +204,30 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     print_distortion(distortion(&mesh, |_| Mat2::IDENTITY), distortion(&mesh, |uv| field.at(uv)));
     let res = args.res;
     eprintln!(
-        "{}: {} triangles ({} mirrored in UV) in {} charts, smoothing {} ({} texels outside every triangle, \
+        "{}: {} triangles ({} mirrored in UV) in {}, smoothing {} ({} texels outside every triangle, \
          extrapolated from the nearest), \
-         {} cut edges in {} cuts (bands for tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
+         {} in {} (bands for tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
          wrote f_map.exr, charts.exr, cuts.json, det_f.png, orientation.png, cut_bands.png to {}",
         args.mesh.display(),
         mesh.indices.len(),
         maps.mirrored,
-        maps.field.charts,
+        counted(maps.field.charts, "chart"),
         match args.smoothing {
             Smoothing::Triangles => "none (each triangle's own F)".to_string(),
-            Smoothing::Vertices(rounds) => format!("per chart, {rounds} rounds"),
+            Smoothing::Vertices(rounds) => format!("per chart, {}", counted(rounds, "round")),
         },
         maps.raster.filled,
-        maps.cuts.edges.len(),
-        maps.cuts.chains.len(),
+        counted(maps.cuts.edges.len(), "cut edge"),
+        counted(maps.cuts.chains.len(), "cut"),
         args.tile_size,
         output.display(),
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// "1 chart", "5 charts".
+fn counted(n: usize, noun: &str) -> String {
+    if n == 1 { format!("1 {noun}") } else { format!("{n} {noun}s") }
 }
 
 /// `tessera analyze`: the figures of [`tessera::deform::analysis`], as text or JSON.

@@ -833,7 +833,8 @@ impl<'a> Loader<'a> {
                 let (eta, k) = match (material, eta, k) {
                     (Some(name), None, None) => named_conductor(name).ok_or_else(|| {
                         self.error(format!(
-                            "{item}.material: unknown conductor '{name}' (known: Al, none; or give eta and k)"
+                            "{item}.material: unknown conductor '{name}' (known: {}; or give eta and k)",
+                            crate::material::conductor_names()
                         ))
                     })?,
                     (None, Some(RgbValue(e)), Some(RgbValue(k))) => {

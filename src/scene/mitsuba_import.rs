@@ -48,7 +48,9 @@ impl MitsubaImport {
 /// (where the scene file will be written) when they can be, absolute otherwise.
 pub fn import_mitsuba(xml: &Path, out_dir: &Path) -> Result<MitsubaImport> {
     let text = read_text_bounded(xml, limits::MAX_SCENE_FILE_BYTES, "a Mitsuba scene")?;
-    let doc = roxmltree::Document::parse(&text).map_err(|e| Error::scene(xml, format!("malformed XML: {e}")))?;
+    let parse = |text| roxmltree::Document::parse(text).map_err(|e| Error::scene(xml, format!("malformed XML: {e}")));
+    let text = with_defaults(&parse(&text)?, &text);
+    let doc = parse(&text)?;
     let root = doc.root_element();
     if root.tag_name().name() != "scene" {
         return Err(Error::scene(xml, format!("the root element is <{}>, not <scene>", root.tag_name().name())));
@@ -57,7 +59,6 @@ pub fn import_mitsuba(xml: &Path, out_dir: &Path) -> Result<MitsubaImport> {
     let mut importer = Importer {
         base,
         out_dir: if out_dir.as_os_str().is_empty() { PathBuf::from(".") } else { out_dir.to_path_buf() },
-        defaults: HashMap::new(),
         ids: HashMap::new(),
         scene: Table::new(),
         materials: Table::new(),
@@ -84,14 +85,29 @@ pub fn import_mitsuba(xml: &Path, out_dir: &Path) -> Result<MitsubaImport> {
     Ok(MitsubaImport { scene, untranslated: importer.untranslated })
 }
 
+/// `text` with the `<default name="..." value="..."/>` parameters of its root substituted for
+/// `$name`, as Mitsuba substitutes them in every attribute (`type` and `id` included); the
+/// first definition of a name counts, and longer names are replaced first, so that `$spp` does
+/// not take the start of `$spp_preview`.
+fn with_defaults(doc: &roxmltree::Document, text: &str) -> String {
+    let mut defaults: Vec<(&str, &str)> = Vec::new();
+    for node in doc.root_element().children().filter(|c| c.has_tag_name("default")) {
+        if let (Some(name), Some(value)) = (node.attribute("name"), node.attribute("value")) {
+            if !defaults.iter().any(|(n, _)| *n == name) {
+                defaults.push((name, value));
+            }
+        }
+    }
+    defaults.sort_by_key(|(name, _)| std::cmp::Reverse(name.len()));
+    defaults.iter().fold(text.to_string(), |text, (name, value)| text.replace(&format!("${name}"), value))
+}
+
 type Node<'a, 'i> = roxmltree::Node<'a, 'i>;
 type Parsed<T> = std::result::Result<T, String>;
 
 struct Importer {
     base: PathBuf,
     out_dir: PathBuf,
-    /// `<default name value>` parameters.
-    defaults: HashMap<String, String>,
     /// Elements with an `id`, for `<ref>`: their translated name (a material or texture).
     ids: HashMap<String, String>,
     scene: Table,
@@ -127,16 +143,9 @@ fn floats(values: &[f32]) -> Value {
 }
 
 impl Importer {
-    /// An attribute with `$name` defaults substituted.
+    /// An attribute's value (`$name` defaults are substituted in the whole file before).
     fn attr(&self, node: Node, name: &str) -> Option<String> {
-        let raw = node.attribute(name)?;
-        let mut value = raw.to_string();
-        if raw.contains('$') {
-            for (key, v) in &self.defaults {
-                value = value.replace(&format!("${key}"), v);
-            }
-        }
-        Some(value)
+        node.attribute(name).map(str::to_string)
     }
 
     fn skip(&mut self, what: String) {
@@ -341,11 +350,7 @@ impl Importer {
     fn scene_children(&mut self, root: Node) -> Parsed<()> {
         for node in root.children().filter(|c| c.is_element()) {
             match node.tag_name().name() {
-                "default" => {
-                    if let (Some(name), Some(value)) = (node.attribute("name"), node.attribute("value")) {
-                        self.defaults.entry(name.to_string()).or_insert_with(|| value.to_string());
-                    }
-                }
+                "default" => {}
                 "integrator" => self.integrator(node)?,
                 "sensor" => self.sensor(node)?,
                 "bsdf" => {
@@ -535,7 +540,7 @@ impl Importer {
                         m.insert("material".into(), name.into());
                     } else {
                         self.skip(format!(
-                            "{}: conductor '{name}' is not in tessera's table (Al, none): rendered as a perfect mirror; \
+                            "{}: conductor '{name}' is not in tessera's table (Mitsuba's but AlSb): rendered as a perfect mirror; \
                              give its eta and k",
                             at(inner)
                         ));
