@@ -46,9 +46,10 @@ fn golden_scenes_round_trip_through_mitsuba_xml() {
     }
 }
 
-/// A scene in Mitsuba's own idioms: `$` defaults (also in a `type`), a `<ref>`-erenced texture and BSDF, a
-/// `twosided` wrapper, a sensor whose field of view spans x by default and whose near clip is
-/// Mitsuba's default, a spot light placed by `lookat`, an exact sphere, a PLY mesh, and things
+/// A scene in Mitsuba's own idioms: `$` defaults (also in a `type`), a `<ref>`-erenced texture
+/// and BSDF, a checkerboard, a `twosided` wrapper, a sensor whose field of view spans x by
+/// default and whose near clip is Mitsuba's default, a spot light placed by `lookat`, an exact
+/// sphere, a PLY mesh, and things
 /// tessera does not have (a Gaussian filter, a `principled` BSDF, a sphere scaled unevenly), each
 /// listed; a serialized file's second mesh.
 #[test]
@@ -66,6 +67,8 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         </sensor>
         <texture type="bitmap" id="checks"><string name="filename" value="checker.png"/></texture>
         <bsdf type="twosided" id="floor"><bsdf type="diffuse"><ref name="reflectance" id="checks"/></bsdf></bsdf>
+        <bsdf type="diffuse" id="board"><texture type="checkerboard" name="reflectance"><rgb name="color1" value="0.1"/>
+            <transform name="to_uv"><scale x="4" y="2"/></transform></texture></bsdf>
         <bsdf type="roughconductor" id="gold"><string name="material" value="Al"/><float name="alpha" value="0.2"/></bsdf>
         <shape type="rectangle"><transform name="to_world"><scale value="5"/><rotate x="1" angle="-90"/></transform><ref id="floor"/></shape>
         <shape type="sphere"><point name="center" x="0" y="1" z="0"/><float name="radius" value="0.8"/><ref id="gold"/></shape>
@@ -73,6 +76,7 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
         <shape type="ply"><string name="filename" value="quad.ply"/></shape>
         <shape type="serialized"><string name="filename" value="quads.serialized"/><integer name="shape_index" value="1"/></shape>
         <shape type="cube"><bsdf type="principled"/></shape>
+        <shape type="rectangle"><ref id="board"/><transform name="to_world"><translate z="-3"/></transform></shape>
         <emitter type="spot">
             <transform name="to_world"><lookat origin="2, 4, 2" target="0, 0, 0"/></transform>
             <rgb name="intensity" value="40, 35, 30"/><float name="cutoff_angle" value="25"/>
@@ -115,7 +119,15 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let spot = &scene.lights.points[0];
     assert!(spot.spot.unwrap().axis().distance(-glam::Vec3::new(2.0, 4.0, 2.0).normalize()) < 1e-5);
     assert!(scene.materials.iter().any(|m| m.name == "materials.floor" && m.two_sided));
-    assert_eq!(scene.geometry.shapes.len(), 6, "rectangle, 2 spheres, PLY, serialized, cube");
+    assert_eq!(scene.geometry.shapes.len(), 7, "rectangle, 2 spheres, PLY, serialized, cube, rectangle");
+    // The checkerboard: Mitsuba's default color0, the given color1, its to_uv as for bitmaps.
+    let board = scene.textures.iter().find_map(|t| match t {
+        tessera::texture::Texture::Checkerboard(b) => Some(*b),
+        _ => None,
+    });
+    let board = board.expect("a checkerboard texture");
+    assert_eq!((board.color0.x, board.color1.x, board.scale), (0.4, 0.1, glam::Vec2::new(4.0, 2.0)));
+    assert_eq!(board.offset, glam::Vec2::new(0.0, -1.0));
     // The serialized file's second mesh: the quad moved by x + 3, double precision.
     let g = &scene.geometry;
     let i = g.shapes.iter().position(|s| s.name.contains("quads.serialized")).unwrap();

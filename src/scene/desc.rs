@@ -244,6 +244,19 @@ pub enum TextureDesc {
         #[serde(default)]
         filter: crate::pups::PupsFilter,
     },
+    /// Mitsuba's checkerboard: `color0` and `color1` alternating over cells of side 1/2.
+    Checkerboard {
+        /// Colour of the cells where both half-period tests agree (linear RGB; default 0.4).
+        color0: Option<RgbValue>,
+        /// Colour of the others (default 0.2).
+        color1: Option<RgbValue>,
+        /// Multiplier of the texture coordinates (default [1, 1]).
+        #[serde(default = "unit_scale")]
+        scale: [f32; 2],
+        /// Offset added to the scaled texture coordinates (default [0, 0]).
+        #[serde(default)]
+        offset: [f32; 2],
+    },
     /// A tile image written by `tessera tiles synth` (paper 001), for a quad mesh whose
     /// texture coordinates `tessera tiles map` assigned: each lookup filters one tile only.
     QuadTiles {

@@ -24,7 +24,7 @@ use crate::pups::{PresetParams, PupsTexture, read_points};
 use crate::texture::tiling_blending::{
     Blend, Charts, CutBands, Deformation, DeformationField, PriorityMap, Synthesis, Tiling, cuts_from_json,
 };
-use crate::texture::{ImageTexture, MipMap, PupsLookup, QuadTilesTexture, Texture, TilingBlending};
+use crate::texture::{Checkerboard, ImageTexture, MipMap, PupsLookup, QuadTilesTexture, Texture, TilingBlending};
 use glam::{Mat2, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::f32::consts::PI;
@@ -355,6 +355,7 @@ impl<'a> Loader<'a> {
                 colorspace.unwrap_or(role_space)
             }
             TextureDesc::TilingBlending(_) | TextureDesc::Pups { .. } => role_space,
+            TextureDesc::Checkerboard { .. } => ColorSpace::Linear,
         };
         let key = (name.to_string(), space);
         if let Some(t) = self.built_textures.get(&key) {
@@ -456,6 +457,16 @@ impl<'a> Loader<'a> {
                 }
                 .map_err(|msg| self.error(format!("textures.{name}: {msg}")))?;
                 Texture::Pups(PupsLookup { texture: Arc::new(texture), scale: Vec2::from(*scale), filter: *filter })
+            }
+            TextureDesc::Checkerboard { color0, color1, scale, offset } => {
+                let color =
+                    |c: &Option<RgbValue>, default: f32| Vec3::from(c.map_or([default; 3], |c| c.0)).extend(1.0);
+                Texture::Checkerboard(Checkerboard {
+                    color0: color(color0, 0.4),
+                    color1: color(color1, 0.2),
+                    scale: Vec2::from(*scale),
+                    offset: Vec2::from(*offset),
+                })
             }
             TextureDesc::QuadTiles { filename, conditions, filter, .. } => {
                 let file = self.resolve_path(filename);

@@ -35,7 +35,7 @@ use crate::image::write_exr;
 use crate::light::{Environment, SpotFalloff};
 use crate::limits;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
-use crate::texture::{BakeFootprint, Channel, Filter, Texture, bake};
+use crate::texture::{BakeFootprint, Channel, Checkerboard, Filter, Texture, bake};
 use glam::{Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -59,11 +59,47 @@ fn rgb_value(c: Rgb) -> String {
     format!("{}, {}, {}", c.x, c.y, c.z)
 }
 
+/// The `to_uv` element of tessera's texture-coordinate scale `s` and offset `o`: tessera reads
+/// uv' = uv s + o with v up; Mitsuba's v runs down (v_m = 1 - v), so the same lookup is
+/// v_m' = v_m s_y + (1 - s_y - o_y).
+fn to_uv_element(s: Vec2, o: Vec2) -> String {
+    format!(
+        "<transform name=\"to_uv\"><scale x=\"{}\" y=\"{}\"/><translate x=\"{}\" y=\"{}\"/></transform>",
+        s.x,
+        s.y,
+        o.x,
+        1.0 - s.y - o.y
+    )
+}
+
+/// A checkerboard as Mitsuba's own `checkerboard`, its colours as a parameter reads them (a
+/// colour times its factor, or a channel times its factor); None for a normal map (baked).
+fn checkerboard(board: &Checkerboard, kind: BakeKind, name: &str) -> Option<String> {
+    let value = |c: glam::Vec4| match kind {
+        BakeKind::Color(scale) => Some(Rgb::from_vec4(c) * Rgb::from(scale.map(f32::from_bits))),
+        BakeKind::Scalar(channel, scale) => {
+            let channel = CHANNELS[channel as usize];
+            Some(Rgb::splat(channel.select(c) * f32::from_bits(scale)))
+        }
+        BakeKind::Normal => None,
+    };
+    Some(format!(
+        "<texture type=\"checkerboard\" name=\"{name}\"><rgb name=\"color0\" value=\"{}\"/>\
+         <rgb name=\"color1\" value=\"{}\"/>{}</texture>",
+        rgb_value(value(board.color0)?),
+        rgb_value(value(board.color1)?),
+        to_uv_element(board.scale, board.offset)
+    ))
+}
+
 /// A `to_world` transform element of matrix `m`.
 fn to_world_element(m: Mat4) -> String {
     let rows = m.transpose().to_cols_array().map(|v| v.to_string()).join(" ");
     format!("<transform name=\"to_world\"><matrix value=\"{rows}\"/></transform>")
 }
+
+/// The channels a scalar bake can read, by their index in [`BakeKind::Scalar`].
+const CHANNELS: [Channel; 5] = [Channel::Mean, Channel::R, Channel::G, Channel::B, Channel::A];
 
 /// How a texture is baked: as a colour (RGB times a factor) or a scalar (a channel times a factor).
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
@@ -98,6 +134,11 @@ impl Exporter<'_> {
     /// square at the export's bake resolution (point lookups).
     fn texture(&mut self, id: TextureId, kind: BakeKind, name: &str) -> Result<String> {
         let texture = &self.scene.textures[id.0 as usize];
+        if let Texture::Checkerboard(board) = texture {
+            if let Some(element) = checkerboard(board, kind, name) {
+                return Ok(element);
+            }
+        }
         let (scale, offset) = match texture {
             Texture::Image(tex) => {
                 if tex.filter != Filter::None {
@@ -108,7 +149,7 @@ impl Exporter<'_> {
                 }
                 (tex.scale, tex.offset)
             }
-            Texture::TilingBlending(_) | Texture::QuadTiles(_) | Texture::Pups(_) => {
+            Texture::TilingBlending(_) | Texture::QuadTiles(_) | Texture::Pups(_) | Texture::Checkerboard(_) => {
                 self.out.warnings.push(format!(
                     "{} is procedural: baked over the UV square at {res}x{res} (lookups outside [0, 1] repeat the bake)",
                     self.scene.texture_names[id.0 as usize],
@@ -155,7 +196,7 @@ impl Exporter<'_> {
                         (file, vec![("R".into(), plane(0)), ("G".into(), plane(1)), ("B".into(), plane(2))])
                     }
                     BakeKind::Scalar(channel, scale) => {
-                        let channel = [Channel::Mean, Channel::R, Channel::G, Channel::B, Channel::A][channel as usize];
+                        let channel = CHANNELS[channel as usize];
                         let scale = f32::from_bits(scale);
                         let values = pixels.map(|(x, y)| channel.select(image.pixel(x, y)) * scale).collect();
                         let file = format!("textures/texture{}_y{}.exr", id.0, self.baked.len());
@@ -168,22 +209,14 @@ impl Exporter<'_> {
                 file
             }
         };
-        // tessera reads uv' = uv s + o with v up; Mitsuba's v runs down (v_m = 1 - v), so the same
-        // lookup is v_m' = v_m s_y + (1 - s_y - o_y).
-        let (s, o) = (scale, offset);
         Ok(format!(
             "<texture type=\"bitmap\" name=\"{name}\">\
              <string name=\"filename\" value=\"{}\"/>\
              <string name=\"filter_type\" value=\"bilinear\"/>\
              <string name=\"wrap_mode\" value=\"repeat\"/>\
-             <boolean name=\"raw\" value=\"true\"/>\
-             <transform name=\"to_uv\"><scale x=\"{}\" y=\"{}\"/><translate x=\"{}\" y=\"{}\"/></transform>\
-             </texture>",
+             <boolean name=\"raw\" value=\"true\"/>{}</texture>",
             xml_escape(&file),
-            s.x,
-            s.y,
-            o.x,
-            1.0 - s.y - o.y
+            to_uv_element(scale, offset)
         ))
     }
 
@@ -200,8 +233,7 @@ impl Exporter<'_> {
         match *p {
             FloatParam::Value(v) => Ok(format!("<float name=\"{name}\" value=\"{v}\"/>")),
             FloatParam::Texture { id, channel, scale } => {
-                let index =
-                    [Channel::Mean, Channel::R, Channel::G, Channel::B, Channel::A].iter().position(|c| *c == channel);
+                let index = CHANNELS.iter().position(|c| *c == channel);
                 self.texture(id, BakeKind::Scalar(index.expect("all channels listed") as u8, scale.to_bits()), name)
             }
         }

@@ -239,22 +239,43 @@ impl Importer {
     /// for other kinds.
     fn texture(&mut self, node: Node) -> Parsed<Option<String>> {
         let kind = node.attribute("type").unwrap_or_default();
-        if kind != "bitmap" {
-            self.skip(format!("{}: only bitmap textures are translated (the parameter keeps its default)", at(node)));
-            return Ok(None);
-        }
-        let filename = self.string(node, "filename").ok_or_else(|| format!("{}: no filename", at(node)))?;
         let mut texture = Table::new();
-        texture.insert("type".into(), "image".into());
-        texture.insert("filename".into(), self.file(&filename).into());
-        if self.boolean(node, "raw") {
-            texture.insert("colorspace".into(), "linear".into());
-        }
-        if let Some(filter) = self.string(node, "filter_type").filter(|f| f != "bilinear") {
-            self.skip(format!("{}: filter_type '{filter}' read bilinearly", at(node)));
-        }
-        if let Some(wrap) = self.string(node, "wrap_mode").filter(|w| w != "repeat") {
-            self.skip(format!("{}: wrap_mode '{wrap}' read as repeat", at(node)));
+        match kind {
+            "bitmap" => {
+                let filename = self.string(node, "filename").ok_or_else(|| format!("{}: no filename", at(node)))?;
+                texture.insert("type".into(), "image".into());
+                texture.insert("filename".into(), self.file(&filename).into());
+                if self.boolean(node, "raw") {
+                    texture.insert("colorspace".into(), "linear".into());
+                }
+                if let Some(filter) = self.string(node, "filter_type").filter(|f| f != "bilinear") {
+                    self.skip(format!("{}: filter_type '{filter}' read bilinearly", at(node)));
+                }
+                if let Some(wrap) = self.string(node, "wrap_mode").filter(|w| w != "repeat") {
+                    self.skip(format!("{}: wrap_mode '{wrap}' read as repeat", at(node)));
+                }
+            }
+            "checkerboard" => {
+                texture.insert("type".into(), "checkerboard".into());
+                for key in ["color0", "color1"] {
+                    match self.color(node, key)? {
+                        Some(Value::String(_)) => {
+                            self.skip(format!("{}: a textured {key} is not translated (its default instead)", at(node)))
+                        }
+                        Some(c) => {
+                            texture.insert(key.into(), c);
+                        }
+                        None => {}
+                    }
+                }
+            }
+            _ => {
+                self.skip(format!(
+                    "{}: only bitmap and checkerboard textures are translated (the parameter keeps its default)",
+                    at(node)
+                ));
+                return Ok(None);
+            }
         }
         if let Some(t) = node.children().find(|c| c.has_tag_name("transform") && c.attribute("name") == Some("to_uv")) {
             let m = self.transform(t)?;

@@ -5,11 +5,13 @@
 //! Values are RGBA; scalar parameters read one channel or the mean of RGB.
 
 mod bake;
+mod checkerboard;
 mod mipmap;
 mod quad_tiles;
 pub mod tiling_blending;
 
 pub use bake::{BakeFootprint, BakeParams, bake, bake_rect};
+pub use checkerboard::Checkerboard;
 pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
@@ -117,6 +119,8 @@ pub enum Texture {
     QuadTiles(QuadTilesTexture),
     /// A partition-of-unity parametric texture (paper 002).
     Pups(PupsLookup),
+    /// Mitsuba's two-colour checkerboard.
+    Checkerboard(Checkerboard),
 }
 
 /// A PUPs texture as a scene reads it: texture coordinates scaled, the footprint filtered.
@@ -147,6 +151,7 @@ impl Texture {
             Texture::TilingBlending(t) => t.eval(ctx),
             Texture::QuadTiles(t) => t.eval(ctx),
             Texture::Pups(t) => t.eval(ctx),
+            Texture::Checkerboard(t) => t.eval(ctx),
         }
     }
 
@@ -176,6 +181,7 @@ impl Texture {
             Texture::TilingBlending(t) => t.uses_footprint(),
             Texture::QuadTiles(t) => t.filter != Filter::None,
             Texture::Pups(t) => t.filter != crate::pups::PupsFilter::None,
+            Texture::Checkerboard(_) => false,
         }
     }
 
@@ -186,6 +192,7 @@ impl Texture {
             Texture::TilingBlending(t) => t.memory_bytes(),
             Texture::QuadTiles(t) => t.memory_bytes(),
             Texture::Pups(t) => t.texture.memory_bytes(),
+            Texture::Checkerboard(_) => 0,
         }
     }
 }
