@@ -182,6 +182,17 @@ fn absurd_parameters_are_rejected() {
     error_of(&format!("{CAMERA}[render]\nspp = 0\n"), &[], &["render.spp"]);
     error_of(&format!("{CAMERA}[render]\nspp = 4000000000\n"), &[], &["render.spp"]);
     error_of(&format!("{CAMERA}[render]\nmax_depth = 0\n"), &[], &["render.max_depth"]);
+    error_of(
+        &format!("{CAMERA}[render]\nfilter = {{ type = \"gaussian\", stddev = -1 }}\n"),
+        &[],
+        &["render.filter", "stddev"],
+    );
+    error_of(
+        &format!("{CAMERA}[render]\nfilter = {{ type = \"tent\", radius = 1e9 }}\n"),
+        &[],
+        &["render.filter", "radius"],
+    );
+    error_of(&format!("{CAMERA}[render]\nfilter = {{ type = \"mitchell\" }}\n"), &[], &["mitchell"]);
     error_of("[camera]\nfov = 0\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n", &[], &["camera.fov"]);
     error_of("[camera]\nfov = 40\neye = [0, 0, 3]\ntarget = [0, 0, 3]\n", &[], &["camera"]);
     error_of(

@@ -12,7 +12,8 @@ use tessera::integrator::{Crop, Ending, PassLimits, render, render_in_passes, re
 fn exr_is_bit_identical_with_one_and_two_threads() {
     let root = common::repo().join("scenes");
     // Everything that draws random numbers: area light and environment map sampling, textures
-    // with every filter, glass, plastic, metal, glTF-style PBR and a normal map.
+    // with every filter, glass, plastic, metal, glTF-style PBR and a normal map, an emitting
+    // exact sphere, and Gaussian pixel filtering (samples around each pixel's centre).
     let toml = format!(
         r#"
         [render]
@@ -20,6 +21,7 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
         height = 20
         spp = 6
         seed = 7
+        filter = {{ type = "gaussian" }}
         [camera]
         fov = 45
         eye = [0, 1.5, 4]
@@ -76,6 +78,11 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
         type = "uv_sphere"
         material = "pbr"
         transform = [{{ scale = 0.3 }}, {{ translate = [0.6, 0.4, 0.5] }}]
+        [[shapes]]
+        type = "sphere"
+        center = [-1, 2, 1]
+        radius = 0.3
+        emission = 4
         [[shapes]]
         type = "rectangle"
         emission = 5

@@ -50,8 +50,8 @@ fn golden_scenes_round_trip_through_mitsuba_xml() {
 /// and BSDF, a checkerboard, a `twosided` wrapper, a sensor whose field of view spans x by
 /// default and whose near clip is Mitsuba's default, a spot light placed by `lookat`, an exact
 /// sphere, a PLY mesh, and things
-/// tessera does not have (a Gaussian filter, a `principled` BSDF, a sphere scaled unevenly), each
-/// listed; a serialized file's second mesh.
+/// tessera does not have (a `principled` BSDF, a sphere scaled unevenly), each listed; a
+/// serialized file's second mesh; Mitsuba's default Gaussian pixel filter.
 #[test]
 fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let xml = r#"<scene version="3.0.0">
@@ -92,16 +92,18 @@ fn a_hand_written_mitsuba_scene_translates_with_its_gaps_listed() {
     let dir = common::scene_dir("", &files);
     let import = import_mitsuba(&dir.path().join("scene.xml"), dir.path()).unwrap();
     let gaps = import.untranslated.join("\n");
-    for expected in ["gaussian", "principled", "ellipsoid", "Beckmann"] {
+    for expected in ["principled", "ellipsoid", "Beckmann"] {
         assert!(gaps.contains(expected), "{expected} should be listed:\n{gaps}");
     }
-    // Defaults apply in every attribute: `type="$integrator"` is the path tracer.
-    assert!(!gaps.contains("integrator"), "{gaps}");
+    // Defaults apply in every attribute: `type="$integrator"` is the path tracer; the film's
+    // filter is Mitsuba's default Gaussian.
+    assert!(!gaps.contains("integrator") && !gaps.contains("filter"), "{gaps}");
     let path = dir.path().join("imported.toml");
     std::fs::write(&path, import.to_toml(&dir.path().join("scene.xml"))).unwrap();
     let scene = load_scene(&path, &SceneOverrides::default()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!((scene.settings.width, scene.settings.height, scene.settings.spp), (64, 48, 32));
     assert_eq!(scene.settings.max_depth, Some(6));
+    assert_eq!(scene.settings.pixel_filter, tessera::image::PixelFilter::Gaussian { stddev: 0.5 });
     // Mitsuba's default near clip, and its field of view along x.
     let model = scene.camera.model();
     assert_eq!(model.near_clip, 0.01);

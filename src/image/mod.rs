@@ -8,6 +8,7 @@ mod film;
 mod io;
 mod merge;
 mod montage;
+mod pixel_filter;
 mod seams;
 mod tonemap;
 
@@ -19,5 +20,6 @@ pub use io::{
 };
 pub use merge::merge_crops;
 pub use montage::montage;
+pub use pixel_filter::{MAX_FILTER_RADIUS, PixelFilter};
 pub use seams::{SeamVisibility, seam_visibility};
 pub use tonemap::ToneMap;

@@ -121,7 +121,7 @@ pub fn render_samples(
                 let key = PixelKey::new(s.seed, pixel_index);
                 let camera_sample = |i: u32| {
                     let mut sampler = key.sampler(i);
-                    let film_pos = Vec2::new(px as f32, py as f32) + sampler.next_2d();
+                    let film_pos = s.pixel_filter.film_position(px, py, sampler.next_2d());
                     // A thin lens takes the next two dimensions; other cameras none, so that
                     // their paths draw the same numbers as before lenses existed.
                     let lens = if scene.camera.needs_lens_sample() { sampler.next_2d() } else { Vec2::ZERO };

@@ -51,12 +51,41 @@ pub struct RenderDesc {
     pub rr_depth: u32,
     /// Seed of the sampler.
     pub seed: u64,
+    /// The pixel reconstruction filter (default `box`).
+    pub filter: PixelFilterDesc,
 }
 
 impl Default for RenderDesc {
     fn default() -> Self {
-        RenderDesc { width: 512, height: 512, spp: 16, max_depth: -1, rr_depth: 5, seed: 0 }
+        RenderDesc {
+            width: 512,
+            height: 512,
+            spp: 16,
+            max_depth: -1,
+            rr_depth: 5,
+            seed: 0,
+            filter: PixelFilterDesc::Box,
+        }
     }
+}
+
+/// `[render.filter]`: Mitsuba's reconstruction filters.
+#[derive(Clone, Copy, Debug, Default, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PixelFilterDesc {
+    /// Each pixel the mean over its square.
+    #[default]
+    Box,
+    /// Mitsuba's `gaussian` (its default filter).
+    Gaussian {
+        /// Standard deviation in pixels (default 0.5, Mitsuba's); the radius is 4 stddev.
+        stddev: Option<f32>,
+    },
+    /// Mitsuba's `tent`.
+    Tent {
+        /// Radius in pixels (default 1).
+        radius: Option<f32>,
+    },
 }
 
 /// `[camera]`: a perspective or orthographic camera, placed by eye/target/up, a matrix, or a

@@ -3,8 +3,8 @@
 
 use super::desc::{
     BlendKind, CameraDesc, ColorValue, DeformationDesc, EnvironmentDesc, FloatValue, IorValue, MaterialDesc,
-    ProjectionKind, RenderDesc, RgbValue, ScaleValue, SceneDesc, ShapeDesc, ShapeKind, TextureDesc, TilingBlendingDesc,
-    TransformStep,
+    PixelFilterDesc, ProjectionKind, RenderDesc, RgbValue, ScaleValue, SceneDesc, ShapeDesc, ShapeKind, TextureDesc,
+    TilingBlendingDesc, TransformStep,
 };
 use super::{Geometry, RenderSettings, Scene};
 use crate::accel::Accel;
@@ -14,7 +14,7 @@ use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::read_text_bounded;
 use crate::geometry::{Sphere, TriangleMesh, obj, ply, serialized, shapes};
-use crate::image::{ColorSpace, read_bitmap, read_bitmap_raw};
+use crate::image::{ColorSpace, PixelFilter, read_bitmap, read_bitmap_raw};
 use crate::light::{AreaLight, Environment, EnvironmentMap, Lights};
 use crate::limits;
 use crate::material::{
@@ -328,7 +328,14 @@ impl<'a> Loader<'a> {
                     .in_scene(self.path, "render"));
             }
         };
-        Ok(RenderSettings { width, height, spp, max_depth, rr_depth: r.rr_depth, seed: o.seed.unwrap_or(r.seed) })
+        let pixel_filter = match r.filter {
+            PixelFilterDesc::Box => Ok(PixelFilter::Box),
+            PixelFilterDesc::Gaussian { stddev } => PixelFilter::gaussian(stddev.unwrap_or(0.5)),
+            PixelFilterDesc::Tent { radius } => PixelFilter::tent(radius.unwrap_or(1.0)),
+        }
+        .map_err(|msg| Error::param("render.filter", msg).in_scene(self.path, "render"))?;
+        let seed = o.seed.unwrap_or(r.seed);
+        Ok(RenderSettings { width, height, spp, max_depth, rr_depth: r.rr_depth, seed, pixel_filter })
     }
 
     fn texture(&mut self, name: &str, role: Role, item: &str) -> Result<TextureId> {

@@ -31,7 +31,7 @@ use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::StagedFolder;
 use crate::geometry::{Frame, Sphere};
-use crate::image::write_exr;
+use crate::image::{PixelFilter, write_exr};
 use crate::light::{Environment, SpotFalloff};
 use crate::limits;
 use crate::material::{ColorParam, FloatParam, Material, MaterialKind, Roughness, TextureId};
@@ -464,6 +464,15 @@ impl Exporter<'_> {
             }
         };
         let to_world = to_world_element(m);
+        let rfilter = match s.pixel_filter {
+            PixelFilter::Box => "<rfilter type=\"box\"/>".to_string(),
+            PixelFilter::Gaussian { stddev } => {
+                format!("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"{stddev}\"/></rfilter>")
+            }
+            PixelFilter::Tent { radius } => {
+                format!("<rfilter type=\"tent\"><float name=\"radius\" value=\"{radius}\"/></rfilter>")
+            }
+        };
         format!(
             "<sensor type=\"{kind}\">{params}\
              <float name=\"near_clip\" value=\"{near_clip}\"/><float name=\"far_clip\" value=\"10000000\"/>\
@@ -471,7 +480,7 @@ impl Exporter<'_> {
              <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{}\"/><integer name=\"seed\" value=\"{}\"/></sampler>\
              <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/>\
              <string name=\"pixel_format\" value=\"rgb\"/><string name=\"component_format\" value=\"float32\"/>\
-             <rfilter type=\"box\"/></film></sensor>",
+             {rfilter}</film></sensor>",
             s.spp, s.seed, s.width, s.height
         )
     }

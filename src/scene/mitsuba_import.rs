@@ -421,15 +421,25 @@ impl Importer {
             }
         };
         let (width, height) = (int(self, film, "width", 768)?, int(self, film, "height", 576)?);
-        if let Some(f) = film {
-            match f.children().find(|c| c.has_tag_name("rfilter")).and_then(|r| r.attribute("type")) {
-                Some("box") => {}
-                other => self.skip(format!(
-                    "{}: reconstruction filter '{}' rendered with a box filter (each pixel the mean of its samples)",
-                    at(f),
-                    other.unwrap_or("gaussian (Mitsuba's default)")
-                )),
+        // Mitsuba's film filters with a Gaussian of stddev 0.5 unless told otherwise.
+        let rfilter = film.and_then(|f| f.children().find(|c| c.has_tag_name("rfilter")));
+        let mut filter = Table::new();
+        match rfilter.map_or("gaussian", |r| r.attribute("type").unwrap_or_default()) {
+            "box" => {}
+            "gaussian" => {
+                filter.insert("type".into(), "gaussian".into());
+                let stddev = rfilter.map(|r| self.float(r, "stddev")).transpose()?.flatten();
+                filter.insert("stddev".into(), num(stddev.unwrap_or(0.5)));
             }
+            "tent" => {
+                filter.insert("type".into(), "tent".into());
+                let radius = rfilter.map(|r| self.float(r, "radius")).transpose()?.flatten();
+                filter.insert("radius".into(), num(radius.unwrap_or(1.0)));
+            }
+            other => self.skip(format!(
+                "{}: reconstruction filter '{other}' rendered with a box filter (each pixel the mean over its square)",
+                at(rfilter.expect("a named filter"))
+            )),
         }
         let sampler = node.children().find(|c| c.has_tag_name("sampler"));
         let spp = int(self, sampler, "sample_count", 4)?;
@@ -440,6 +450,9 @@ impl Importer {
         let render = self.render_table();
         for (k, v) in [("width", width), ("height", height), ("spp", spp), ("seed", seed)] {
             render.insert(k.into(), Value::Integer(v));
+        }
+        if !filter.is_empty() {
+            render.insert("filter".into(), Value::Table(filter));
         }
         let to_world = self.to_world(node)?.unwrap_or(Mat4::IDENTITY);
         // Mitsuba's camera looks down +z with x left; tessera's down -z with x right.

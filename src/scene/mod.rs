@@ -46,7 +46,7 @@ use glam::{Vec2, Vec3};
 use std::path::PathBuf;
 
 /// Image and integrator settings (the scene's `[render]` table after command-line overrides).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
     /// Image width in pixels.
     pub width: u32,
@@ -60,6 +60,8 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     /// Sampler seed.
     pub seed: u64,
+    /// How samples are spread over and around each pixel.
+    pub pixel_filter: crate::image::PixelFilter,
 }
 
 /// A shape as the renderer sees it after loading.
