@@ -21,8 +21,8 @@ use tessera::texture::{Filter, ImageTexture, MipMap, Texture};
 /// The mesh and the parameters of its deformation field.
 #[derive(Args)]
 pub struct MeshArgs {
-    /// The mesh with texture coordinates: OBJ, or glTF 2.0 (.gltf, .glb; all its triangle
-    /// primitives in world space).
+    /// The mesh with texture coordinates: OBJ, PLY, Mitsuba serialized (its first mesh), or
+    /// glTF 2.0 (.gltf, .glb; all its triangle primitives in world space).
     mesh: PathBuf,
     /// Rounds of averaging of the field over each UV vertex's triangles, within its chart
     /// (Sec. 4.4; 0 keeps each vertex the mean of its triangles; at most 256), or `triangles`:
