@@ -170,7 +170,7 @@ impl Sphere {
     pub fn sample_from(&self, p: Vec3, u: Vec2) -> Option<SphereSample> {
         let to_center = self.center - p;
         let dc2 = to_center.length_squared();
-        let point = if self.sees_from_outside(p) {
+        let (point, pdf) = if self.sees_from_outside(p) {
             let dc = dc2.sqrt();
             let sin2_max = (self.radius * self.radius / dc2).min(1.0);
             let one_minus_cos_max = one_minus_cos_from_sin2(sin2_max);
@@ -179,12 +179,12 @@ impl Sphere {
             let sin2 = w.x * w.x + w.y * w.y;
             let chord = (self.radius * self.radius - dc2 * sin2).max(0.0).sqrt();
             let dir = Frame::from_normal(to_center / dc).to_world(w);
-            p + dir * (dc * w.z - chord)
+            (p + dir * (dc * w.z - chord), warp::uniform_cone_pdf(one_minus_cos_max))
         } else {
-            self.center + self.to_world_linear * warp::square_to_uniform_sphere(u)
+            let point = self.center + self.to_world_linear * warp::square_to_uniform_sphere(u);
+            (point, self.pdf_from(p, (point - p).normalize()))
         };
         let normal = self.normal_at(point);
-        let pdf = self.pdf_from(p, (point - p).normalize());
         (pdf > 0.0 && pdf.is_finite()).then_some(SphereSample { point, normal, pdf })
     }
 
