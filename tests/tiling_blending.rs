@@ -630,3 +630,53 @@ fn tiles_that_read_the_field_at_their_centres_are_affine_and_keep_to_their_chart
     let refusal = texture.gpu_synthesis().err().expect("not ported");
     assert!(refusal.contains("tile_centre"), "{refusal}");
 }
+
+#[test]
+fn mix_max_is_the_product_of_its_duels_whether_the_priority_is_read_with_the_exemplar_or_not() {
+    // Mix-Max from its definition, in f64: tile i's weight is the product over the other tiles
+    // of Phi((s_i - s_j) / sqrt(sigma_i^2 + sigma_j^2 + 2 lambda^2)), s = c mean + ln w,
+    // sigma^2 = c^2 variance of the priority over the footprint, normalised. The priority map
+    // is the exemplar's own (read at the exemplar's addresses, one lookup for both) and another
+    // image's of another size (read on its own); both must give the definition.
+    let (contrast, lambda) = (4.0f32, 0.05f32);
+    for filter in [Filter::None, Filter::Trilinear, Filter::Ewa] {
+        let exemplar = image_texture(64, gaussian_field(64, 2.0, 31), filter);
+        let other = image_texture(32, gaussian_field(32, 1.5, 32), filter);
+        for source in [&exemplar, &other] {
+            let Texture::Image(priority_image) = source.as_ref() else { unreachable!() };
+            let priority = PriorityMap::new(priority_image);
+            let blend = Blend::MixMax { priority: priority.clone(), contrast, lambda };
+            let deformation = Some(vec![Deformation::Rotation { angle: 0.3, gradient: Vec2::new(2.0, 1.0) }]);
+            let s = synthesis(Tiling::Hexagonal, blend, deformation);
+            let t = tb(&s, &exemplar);
+            for i in 0..2000u64 {
+                let mut rng = Sampler::new(33, i, 0);
+                let uv = rng.next_2d() * 3.0;
+                let d = Vec2::from_angle(rng.next_1d() * 6.3) * 0.02 * rng.next_1d();
+                let ctx = TexCtx { uv, duv_dx: d, duv_dy: d.perp() * 0.5, uv_mirrored: None };
+                let (lookups, k) = s.lookups(&ctx);
+                let score_and_var = |l: &tessera::texture::tiling_blending::TileLookup| {
+                    let m = priority.image().eval(&l.ctx);
+                    let (mean, var) = (m.x as f64, (m.w as f64 - (m.x as f64).powi(2)).max(0.0));
+                    (contrast as f64 * mean + (l.weight as f64).ln(), (contrast as f64).powi(2) * var)
+                };
+                let duels: Vec<(f64, f64)> = lookups[..k].iter().map(score_and_var).collect();
+                let weights: Vec<f64> = (0..k)
+                    .map(|a| {
+                        (0..k)
+                            .filter(|&b| b != a)
+                            .map(|b| {
+                                let spread = duels[a].1 + duels[b].1 + 2.0 * (lambda as f64).powi(2);
+                                tessera::math::normal_cdf((duels[a].0 - duels[b].0) / spread.sqrt())
+                            })
+                            .product()
+                    })
+                    .collect();
+                let total: f64 = weights.iter().sum();
+                let expected: f64 = (0..k).map(|a| weights[a] / total * exemplar.eval(&lookups[a].ctx).x as f64).sum();
+                let got = t.eval(&ctx).x as f64;
+                assert!((got - expected).abs() < 2e-5, "{filter:?} at {uv}: {got} vs {expected}");
+            }
+        }
+    }
+}

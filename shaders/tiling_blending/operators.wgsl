@@ -51,19 +51,24 @@ fn blend_weights(lookups: Lookups) -> array<f32, 8> {
             variance[i] = contrast * contrast * max(v.w - v.x * v.x, 0.0);
         }
     }
+    // Each pair of live tiles duels once: p to one weight, 1 - p to the other.
     var mixed: array<f32, 8>;
-    var sum = 0.0;
     for (var i = 0u; i < n; i++) {
-        mixed[i] = 0.0;
+        mixed[i] = select(0.0, 1.0, lookups.lookup[i].weight > 0.0);
+    }
+    for (var i = 0u; i < n; i++) {
         if lookups.lookup[i].weight > 0.0 {
-            var p = 1.0;
-            for (var j = 0u; j < n; j++) {
-                if j != i && lookups.lookup[j].weight > 0.0 {
-                    p *= win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda);
+            for (var j = i + 1u; j < n; j++) {
+                if lookups.lookup[j].weight > 0.0 {
+                    let p = win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda);
+                    mixed[i] *= p;
+                    mixed[j] *= 1.0 - p;
                 }
             }
-            mixed[i] = p;
         }
+    }
+    var sum = 0.0;
+    for (var i = 0u; i < n; i++) {
         sum += mixed[i];
     }
     if sum > 0.0 {

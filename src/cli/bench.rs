@@ -235,7 +235,8 @@ fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Re
         );
         println!(
             "           vs Mitsuba 3.9.1 on 2 cores (measured separately): llvm_ad_rgb {MITSUBA_LLVM_MSAMPLES} -> {:.2}x, \
-             scalar_rgb {MITSUBA_SCALAR_MSAMPLES} -> {:.2}x (target 1.5x llvm)",
+             scalar_rgb {MITSUBA_SCALAR_MSAMPLES} -> {:.2}x (target 1.5x llvm); \
+             measured in one session, alternating: python3 reference/bench.py",
             rate / MITSUBA_LLVM_MSAMPLES,
             rate / MITSUBA_SCALAR_MSAMPLES
         );

@@ -40,6 +40,26 @@ static EWA_WEIGHTS: std::sync::LazyLock<[f32; EWA_LUT_SIZE]> = std::sync::LazyLo
     })
 });
 
+/// A footprint prepared for the lookups of one pyramid ([`MipMap::prepare`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PreparedFootprint {
+    /// Bilinear at the finest level (no filter, or a degenerate EWA ellipse).
+    Point,
+    /// Trilinear at this continuous level.
+    Levels(f32),
+    /// EWA over an ellipse, at a continuous level.
+    Ellipse {
+        /// The longer axis, in image units.
+        dst0: Vec2,
+        /// The shorter axis (widened to the largest anisotropy), in image units.
+        dst1: Vec2,
+        /// The level.
+        lod: f32,
+    },
+    /// Wider than the image: the coarsest level's one texel.
+    Coarsest,
+}
+
 /// An image and its successively halved, box-filtered reductions down to 1x1.
 #[derive(Clone, Debug)]
 pub struct MipMap {
@@ -111,6 +131,50 @@ fn ewa_weight(lut: &[f32; EWA_LUT_SIZE], r2: f32) -> f32 {
     lut[i] * (1.0 - t) + lut[i + 1] * t
 }
 
+/// What a filtered lookup blends: one pyramid's texel, or two pyramids' read at one address
+/// ([`MipMap::lookup_pair`]). The filters are written once for both.
+trait Texel:
+    Copy + std::ops::Add<Output = Self> + std::ops::Mul<f32, Output = Self> + std::ops::Div<f32, Output = Self>
+{
+    const ZERO: Self;
+}
+
+impl Texel for Vec4 {
+    const ZERO: Self = Vec4::ZERO;
+}
+
+/// The texels of two pyramids at one address, blended alike.
+#[derive(Clone, Copy)]
+struct TexelPair(Vec4, Vec4);
+
+impl Texel for TexelPair {
+    const ZERO: Self = TexelPair(Vec4::ZERO, Vec4::ZERO);
+}
+
+impl std::ops::Add for TexelPair {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        TexelPair(self.0 + o.0, self.1 + o.1)
+    }
+}
+
+impl std::ops::Mul<f32> for TexelPair {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, w: f32) -> Self {
+        TexelPair(self.0 * w, self.1 * w)
+    }
+}
+
+impl std::ops::Div<f32> for TexelPair {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, w: f32) -> Self {
+        TexelPair(self.0 / w, self.1 / w)
+    }
+}
+
 impl MipMap {
     /// Build the pyramid: each level halves each side (rounding down, at least 1).
     pub fn new(base: Bitmap) -> Self {
@@ -148,41 +212,108 @@ impl MipMap {
         self.levels.iter().map(|l| l.data.len() * 4).sum()
     }
 
-    /// Texel (x, y) of `level`, wrapping.
+    /// Column or row `i` of a level `n` texels long: wrapped, or clamped to the edge.
     #[inline(always)]
-    fn texel(&self, level: usize, x: i64, y: i64) -> Vec4 {
-        let l = &self.levels[level];
-        if self.clamp {
-            l.pixel(x.clamp(0, l.width as i64 - 1) as usize, y.clamp(0, l.height as i64 - 1) as usize)
-        } else {
-            l.pixel(wrap(x, l.width), wrap(y, l.height))
-        }
+    fn index(&self, i: i64, n: usize) -> usize {
+        if self.clamp { i.clamp(0, n as i64 - 1) as usize } else { wrap(i, n) }
     }
 
     /// Bilinear interpolation of `level` at `st` (image coordinates in [0, 1]: x right, y down),
     /// with texel centres at ((i + 0.5) / W, (j + 0.5) / H).
     #[inline]
     pub fn bilinear(&self, level: usize, st: Vec2) -> Vec4 {
+        self.bilinear_of(level, st, |x, y| self.levels[level].pixel(x, y))
+    }
+
+    /// Bilinear interpolation at `st` of what `texel(x, y)` reads at `level` (x, y in range).
+    #[inline(always)]
+    fn bilinear_of<T: Texel>(&self, level: usize, st: Vec2, texel: impl Fn(usize, usize) -> T) -> T {
         let l = &self.levels[level];
         let x = st.x * l.width as f32 - 0.5;
         let y = st.y * l.height as f32 - 0.5;
         let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let top = self.texel(level, x0, y0) * (1.0 - fx) + self.texel(level, x0 + 1, y0) * fx;
-        let bottom = self.texel(level, x0, y0 + 1) * (1.0 - fx) + self.texel(level, x0 + 1, y0 + 1) * fx;
+        let (x0, x1) = (self.index(x0, l.width), self.index(x0 + 1, l.width));
+        let (y0, y1) = (self.index(y0, l.height), self.index(y0 + 1, l.height));
+        let top = texel(x0, y0) * (1.0 - fx) + texel(x1, y0) * fx;
+        let bottom = texel(x0, y1) * (1.0 - fx) + texel(x1, y1) * fx;
         top * (1.0 - fy) + bottom * fy
     }
 
     /// Filtered lookup at `st` with the footprint's image-space derivatives `dst0`, `dst1` (in
     /// [0, 1] image units per pixel).
     pub fn lookup(&self, filter: Filter, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
+        self.lookup_prepared(&self.prepare(filter, dst0, dst1), st)
+    }
+
+    /// What every lookup with `filter` over the footprint `dst0`, `dst1` shares, wherever it
+    /// reads: the MIP levels and the EWA ellipse. Lookups of several points with one footprint
+    /// (the tiles of a tiling and blending) prepare it once.
+    pub fn prepare(&self, filter: Filter, dst0: Vec2, dst1: Vec2) -> PreparedFootprint {
+        match filter {
+            Filter::None => PreparedFootprint::Point,
+            Filter::Trilinear => PreparedFootprint::Levels(self.trilinear_lod(dst0, dst1)),
+            Filter::Ewa => match self.ewa_axes(dst0, dst1) {
+                // A footprint wider than the whole image reads the coarsest level, whose one
+                // texel every weight would fall on (pbrt-v4 returns it too): looping over the
+                // ellipse there would cost its area in texels, without bound.
+                Some((_, _, shorter)) if shorter.log2() >= (self.levels.len() - 1) as f32 => {
+                    PreparedFootprint::Coarsest
+                }
+                Some((dst0, dst1, shorter)) => PreparedFootprint::Ellipse { dst0, dst1, lod: self.lod(shorter) },
+                None => PreparedFootprint::Point,
+            },
+        }
+    }
+
+    /// [`MipMap::lookup`] at `st` with a footprint prepared by [`MipMap::prepare`] (bit for bit).
+    pub fn lookup_prepared(&self, footprint: &PreparedFootprint, st: Vec2) -> Vec4 {
+        self.filtered(footprint, st, |level, x, y| self.levels[level].pixel(x, y))
+    }
+
+    /// The lookups of this pyramid and of `other` at once, as two calls of
+    /// [`MipMap::lookup`] give them (bit for bit), for the cost of one lookup's addressing and
+    /// filter weights: two layers of one texture (an exemplar and its Mix-Max priority map).
+    /// None unless the two pyramids' levels have the same sizes and edge handling.
+    pub fn lookup_pair(&self, other: &MipMap, footprint: &PreparedFootprint, st: Vec2) -> Option<(Vec4, Vec4)> {
+        if !self.same_layout(other) {
+            return None;
+        }
+        let pair = self.filtered(footprint, st, |level, x, y| {
+            TexelPair(self.levels[level].pixel(x, y), other.levels[level].pixel(x, y))
+        });
+        Some((pair.0, pair.1))
+    }
+
+    /// Whether `other`'s levels have the sizes of this one's, with the same edge handling, so
+    /// that one texel address serves both.
+    pub fn same_layout(&self, other: &MipMap) -> bool {
+        self.clamp == other.clamp
+            && self.levels.len() == other.levels.len()
+            && self.levels.iter().zip(&other.levels).all(|(a, b)| (a.width, a.height) == (b.width, b.height))
+    }
+
+    /// The lookup of [`MipMap::lookup_prepared`], of what `texel(level, x, y)` reads (x, y in
+    /// range).
+    #[inline(always)]
+    fn filtered<T: Texel>(
+        &self,
+        footprint: &PreparedFootprint,
+        st: Vec2,
+        texel: impl Fn(usize, usize, usize) -> T,
+    ) -> T {
         // Wrap first so that f32 precision does not degrade far from the origin.
         let st = if self.clamp { st.clamp(Vec2::ZERO, Vec2::ONE) } else { st - floor2(st) };
-        match filter {
-            Filter::None => self.bilinear(0, st),
-            Filter::Trilinear => self.at_level(self.trilinear_lod(dst0, dst1), |level| self.bilinear(level, st)),
-            Filter::Ewa => self.ewa(st, dst0, dst1),
+        match *footprint {
+            PreparedFootprint::Point => self.bilinear_of(0, st, |x, y| texel(0, x, y)),
+            PreparedFootprint::Levels(lod) => {
+                self.at_level(lod, |level| self.bilinear_of(level, st, |x, y| texel(level, x, y)))
+            }
+            PreparedFootprint::Ellipse { dst0, dst1, lod } => {
+                self.at_level(lod, |level| self.ewa_level(level, st, dst0, dst1, &texel))
+            }
+            PreparedFootprint::Coarsest => texel(self.levels.len() - 1, 0, 0),
         }
     }
 
@@ -212,7 +343,8 @@ impl MipMap {
     }
 
     /// Blend `f` of the two levels around the continuous level `lod`.
-    fn at_level(&self, lod: f32, f: impl Fn(usize) -> Vec4) -> Vec4 {
+    #[inline(always)]
+    fn at_level<T: Texel>(&self, lod: f32, f: impl Fn(usize) -> T) -> T {
         let i = lod as usize;
         let t = lod - i as f32;
         if t == 0.0 || i + 1 >= self.levels.len() { f(i) } else { f(i) * (1.0 - t) + f(i + 1) * t }
@@ -238,24 +370,17 @@ impl MipMap {
         (shorter > 0.0).then_some((dst0, dst1, shorter))
     }
 
-    fn ewa(&self, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
-        match self.ewa_axes(dst0, dst1) {
-            // A footprint wider than the whole image reads the coarsest level, whose one texel
-            // every weight would fall on (pbrt-v4 returns it too): looping over the ellipse
-            // there would cost its area in texels, without bound.
-            Some((_, _, shorter)) if shorter.log2() >= (self.levels.len() - 1) as f32 => {
-                self.texel(self.levels.len() - 1, 0, 0)
-            }
-            Some((dst0, dst1, shorter)) => {
-                self.at_level(self.lod(shorter), |level| self.ewa_level(level, st, dst0, dst1))
-            }
-            None => self.bilinear(0, st),
-        }
-    }
-
     /// EWA over one level: Gaussian weights inside the ellipse spanned by `dst0` and `dst1`
     /// (pbrt-v4 `MIPMap::EWA`).
-    fn ewa_level(&self, level: usize, st: Vec2, dst0: Vec2, dst1: Vec2) -> Vec4 {
+    #[inline(always)]
+    fn ewa_level<T: Texel>(
+        &self,
+        level: usize,
+        st: Vec2,
+        dst0: Vec2,
+        dst1: Vec2,
+        texel: &impl Fn(usize, usize, usize) -> T,
+    ) -> T {
         let l = &self.levels[level];
         let res = Vec2::new(l.width as f32, l.height as f32);
         // The image repeats: start from the first period, so that the ellipse's bounds below are
@@ -281,7 +406,7 @@ impl MipMap {
         let t0 = (c.y - 2.0 * inv_det * v_sqrt).ceil() as i64;
         let t1 = ((c.y + 2.0 * inv_det * v_sqrt).floor() as i64).min(t0 + MAX_EWA_SPAN);
         let lut = &*EWA_WEIGHTS;
-        let mut sum = Vec4::ZERO;
+        let mut sum = T::ZERO;
         let mut weights = 0.0;
         for it in t0..=t1 {
             let tt = it as f32 - c.y;
@@ -290,12 +415,12 @@ impl MipMap {
                 let r2 = a * ss * ss + b * ss * tt + cc * tt * tt;
                 if r2 < 1.0 {
                     let w = ewa_weight(lut, r2);
-                    sum += self.texel(level, is, it) * w;
+                    sum = sum + texel(level, self.index(is, l.width), self.index(it, l.height)) * w;
                     weights += w;
                 }
             }
         }
-        if weights > 0.0 { sum / weights } else { self.bilinear(level, st) }
+        if weights > 0.0 { sum / weights } else { self.bilinear_of(level, st, |x, y| texel(level, x, y)) }
     }
 }
 
@@ -371,5 +496,42 @@ mod tests {
         let near = m.lookup(Filter::Ewa, Vec2::new(0.25, 0.5), Vec2::new(0.1, 0.0), Vec2::new(0.0, 0.05));
         let far = m.lookup(Filter::Ewa, Vec2::new(4096.25, -8191.5), Vec2::new(0.1, 0.0), Vec2::new(0.0, 0.05));
         assert!((near - far).abs().max_element() < 1e-4, "{near} vs {far}");
+    }
+
+    #[test]
+    fn a_pair_of_lookups_is_two_lookups_bit_for_bit() {
+        let noise = |w: usize, h: usize, channels: usize, seed: usize| {
+            let mut b = Bitmap::new(w, h, channels);
+            for (i, v) in b.data.iter_mut().enumerate() {
+                *v = (((i + seed) * 2_654_435_761) % 1000) as f32 / 1000.0;
+            }
+            b
+        };
+        for (a, b) in [
+            (MipMap::new(noise(37, 20, 4, 1)), MipMap::new(noise(37, 20, 2, 2))),
+            (MipMap::clamped(noise(16, 16, 3, 3)), MipMap::clamped(noise(16, 16, 1, 4))),
+        ] {
+            for filter in [Filter::None, Filter::Trilinear, Filter::Ewa] {
+                for i in 0..500 {
+                    let st = Vec2::new(i as f32 * 0.0137 - 2.0, (i * i) as f32 * 0.0031 - 1.0);
+                    let d0 = Vec2::from_angle(i as f32) * (0.3 / (1 + i % 50) as f32);
+                    let d1 = d0.perp() * 0.4;
+                    let (va, vb) = a.lookup_pair(&b, &a.prepare(filter, d0, d1), st).expect("same layout");
+                    assert_eq!(va, a.lookup(filter, st, d0, d1), "{filter:?} {st}");
+                    assert_eq!(vb, b.lookup(filter, st, d0, d1), "{filter:?} {st}");
+                }
+            }
+        }
+        // Pyramids of other sizes or edge handling are not paired.
+        assert!(
+            MipMap::new(noise(8, 8, 1, 0))
+                .lookup_pair(&MipMap::new(noise(8, 4, 1, 0)), &PreparedFootprint::Point, Vec2::ZERO)
+                .is_none()
+        );
+        assert!(
+            MipMap::new(noise(8, 8, 1, 0))
+                .lookup_pair(&MipMap::clamped(noise(8, 8, 1, 0)), &PreparedFootprint::Point, Vec2::ZERO)
+                .is_none()
+        );
     }
 }

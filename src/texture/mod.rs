@@ -12,7 +12,7 @@ pub mod tiling_blending;
 
 pub use bake::{BakeFootprint, BakeParams, bake, bake_rect};
 pub use checkerboard::Checkerboard;
-pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap};
+pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap, PreparedFootprint};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
 
@@ -94,6 +94,25 @@ impl ImageTexture {
         let uv = ctx.uv * self.scale + self.offset;
         let st = image_coordinates(uv);
         self.mipmap.lookup(self.filter, st, self.image_step(ctx.duv_dx), self.image_step(ctx.duv_dy))
+    }
+
+    /// The lookup's footprint prepared for [`ImageTexture::eval_prepared`]: lookups at several
+    /// points with one footprint share it.
+    pub fn prepare(&self, duv_dx: Vec2, duv_dy: Vec2) -> PreparedFootprint {
+        self.mipmap.prepare(self.filter, self.image_step(duv_dx), self.image_step(duv_dy))
+    }
+
+    /// [`ImageTexture::eval`] at `uv` with the footprint [`ImageTexture::prepare`] gave (bit for
+    /// bit).
+    pub fn eval_prepared(&self, uv: Vec2, footprint: &PreparedFootprint) -> Vec4 {
+        self.mipmap.lookup_prepared(footprint, image_coordinates(uv * self.scale + self.offset))
+    }
+
+    /// [`ImageTexture::eval_prepared`] of this image and of `other`, a pyramid of the same layout
+    /// read with this image's filter and mapping, at one addressing (the same values as two
+    /// lookups, bit for bit). None when the layouts differ.
+    pub fn eval_pair(&self, other: &MipMap, uv: Vec2, footprint: &PreparedFootprint) -> Option<(Vec4, Vec4)> {
+        self.mipmap.lookup_pair(other, footprint, image_coordinates(uv * self.scale + self.offset))
     }
 
     /// The continuous MIP level that [`ImageTexture::eval`] reads at the lookup.

@@ -33,15 +33,17 @@ pub use shift::{cut_shift, fold_seed, shift};
 pub use synthesis::{MAX_LOOKUPS, Synthesis, TileLookup};
 pub use tiling::{MAX_TILES, Tile, Tiling};
 
-use super::{TexCtx, Texture};
+use super::{PreparedFootprint, TexCtx, Texture};
 use glam::{Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
 /// The exemplar of a tiling-and-blending texture, as its blending operator needs it.
 #[derive(Clone, Debug)]
 enum Exemplar {
-    /// Read directly; `mean` for the variance-preserving operator.
-    Plain { texture: Arc<Texture>, mean: Vec4 },
+    /// Read directly; `mean` for the variance-preserving operator. `paired_priority`: the
+    /// exemplar is an image whose Mix-Max priority map reads like it (same layout, filter and
+    /// mapping), so that one addressing reads both ([`ImageTexture::eval_pair`]).
+    Plain { texture: Arc<Texture>, mean: Vec4, paired_priority: bool },
     /// Read in Gaussian space (histogram-preserving operator).
     Gaussianized(Box<GaussianizedExemplar>),
 }
@@ -65,7 +67,14 @@ impl TilingBlending {
             (Blend::HistogramPreserving, _) => {
                 return Err("the histogram_preserving operator needs an image exemplar".into());
             }
-            _ => Exemplar::Plain { mean: texture_mean(&exemplar), texture: exemplar },
+            _ => Exemplar::Plain {
+                mean: texture_mean(&exemplar),
+                paired_priority: match (&synthesis.blend, exemplar.as_ref()) {
+                    (Blend::MixMax { priority, .. }, Texture::Image(image)) => priority.reads_like(image),
+                    _ => false,
+                },
+                texture: exemplar,
+            },
         };
         Ok(TilingBlending { synthesis, exemplar })
     }
@@ -95,11 +104,8 @@ impl TilingBlending {
         let lookups = &lookups[..k];
         let mut values = [Vec4::ZERO; MAX_LOOKUPS];
         match &self.exemplar {
-            Exemplar::Plain { texture, mean } => {
-                for i in 0..k {
-                    values[i] = texture.eval(&lookups[i].ctx);
-                }
-                let w = s.blend.weights(lookups, &values, Some(texture));
+            Exemplar::Plain { texture, mean, paired_priority } => {
+                let (values, w) = self.values_and_weights(texture, *paired_priority, lookups);
                 match s.blend {
                     Blend::VariancePreserving => operators::variance_preserving(&w[..k], &values[..k], *mean),
                     _ => (0..k).map(|i| values[i] * w[i]).sum(),
@@ -118,20 +124,56 @@ impl TilingBlending {
         }
     }
 
+    /// The exemplar `texture`'s values at the tiles' `lookups` and the operator's weights;
+    /// `paired_priority` as in [`Exemplar::Plain`].
+    fn values_and_weights(
+        &self,
+        texture: &Arc<Texture>,
+        paired_priority: bool,
+        lookups: &[TileLookup],
+    ) -> ([Vec4; MAX_LOOKUPS], [f32; MAX_LOOKUPS]) {
+        let mut values = [Vec4::ZERO; MAX_LOOKUPS];
+        let Texture::Image(image) = texture.as_ref() else {
+            for (value, lookup) in values.iter_mut().zip(lookups) {
+                *value = texture.eval(&lookup.ctx);
+            }
+            return (values, self.synthesis.blend.weights(lookups, &values, Some(texture)));
+        };
+        // The tiles' footprints are F times the same one, and equal where F is read at the
+        // point: each footprint is prepared once for the tiles in a row that share it.
+        let mut prepared: Option<(Vec2, Vec2, PreparedFootprint)> = None;
+        let mut footprint = |ctx: &TexCtx| match prepared {
+            Some((dx, dy, footprint)) if (dx, dy) == (ctx.duv_dx, ctx.duv_dy) => footprint,
+            _ => {
+                let footprint = image.prepare(ctx.duv_dx, ctx.duv_dy);
+                prepared = Some((ctx.duv_dx, ctx.duv_dy, footprint));
+                footprint
+            }
+        };
+        if let (true, Blend::MixMax { priority, contrast, lambda }) = (paired_priority, &self.synthesis.blend) {
+            let mut moments = [(0.0, 0.0); MAX_LOOKUPS];
+            for (i, lookup) in lookups.iter().enumerate() {
+                let (value, p) = image
+                    .eval_pair(&priority.image().mipmap, lookup.ctx.uv, &footprint(&lookup.ctx))
+                    .expect("layouts checked");
+                (values[i], moments[i]) = (value, PriorityMap::moments(p));
+            }
+            return (values, operators::mix_max_weights(lookups, &moments[..lookups.len()], *contrast, *lambda));
+        }
+        for (value, lookup) in values.iter_mut().zip(lookups) {
+            *value = image.eval_prepared(lookup.ctx.uv, &footprint(&lookup.ctx));
+        }
+        (values, self.synthesis.blend.weights(lookups, &values, Some(texture)))
+    }
+
     /// A tangent-space normal map read through the synthesis: the tiles' normals (RGB in [0, 1]
     /// encoding 2 rgb - 1) are blended as slopes (x / z, y / z) with the operator's weights,
     /// never as raw RGB, and returned as a unit normal in the exemplar's frame (DESIGN.md
     /// section 4). [`TilingBlending::tangent_direction`] says where that frame's x axis lies.
     pub fn eval_normal(&self, ctx: &TexCtx) -> Option<Vec3> {
-        let Exemplar::Plain { texture, .. } = &self.exemplar else { return None };
-        let s = &*self.synthesis;
-        let (lookups, k) = s.lookups(ctx);
-        let lookups = &lookups[..k];
-        let mut values = [Vec4::ZERO; MAX_LOOKUPS];
-        for i in 0..k {
-            values[i] = texture.eval(&lookups[i].ctx);
-        }
-        let w = s.blend.weights(lookups, &values, Some(texture));
+        let Exemplar::Plain { texture, paired_priority, .. } = &self.exemplar else { return None };
+        let (lookups, k) = self.synthesis.lookups(ctx);
+        let (values, w) = self.values_and_weights(texture, *paired_priority, &lookups[..k]);
         let total: f32 = w[..k].iter().sum();
         let mut slope = Vec2::ZERO;
         for i in 0..k {

@@ -98,8 +98,21 @@ impl PriorityMap {
     /// Mean and variance of the priority over the lookup's footprint.
     #[inline]
     pub(super) fn mean_and_variance(&self, ctx: &TexCtx) -> (f32, f32) {
-        let v = self.map.eval(ctx);
+        Self::moments(self.map.eval(ctx))
+    }
+
+    /// Mean and variance from a filtered value of the map.
+    #[inline]
+    pub(super) fn moments(v: Vec4) -> (f32, f32) {
         (v.x, (v.w - v.x * v.x).max(0.0))
+    }
+
+    /// Whether every lookup of `image` reads this map at the same texels with the same filter
+    /// weights, so that one [`ImageTexture::eval_pair`] reads both.
+    pub(super) fn reads_like(&self, image: &ImageTexture) -> bool {
+        let m = &self.map;
+        (m.filter, m.scale, m.offset) == (image.filter, image.scale, image.offset)
+            && image.mipmap.same_layout(&m.mipmap)
     }
 
     fn memory_bytes(&self) -> usize {
@@ -136,35 +149,14 @@ impl Blend {
                 }
             }
             Blend::MixMax { priority, contrast, lambda } => {
-                let mut score = [f32::NEG_INFINITY; MAX_LOOKUPS];
-                let mut variance = [0.0; MAX_LOOKUPS];
-                // Tiles of weight 0 (outside a cut band's reach) take no part.
-                let live = |i: usize| lookups[i].weight > 0.0;
-                for i in (0..k).filter(|&i| live(i)) {
-                    let (s, var) = priority.mean_and_variance(&lookups[i].ctx);
-                    score[i] = contrast * s + lookups[i].weight.ln();
-                    variance[i] = contrast * contrast * var;
+                let mut moments = [(0.0, 0.0); MAX_LOOKUPS];
+                for i in (0..k).filter(|&i| lookups[i].weight > 0.0) {
+                    moments[i] = priority.mean_and_variance(&lookups[i].ctx);
                 }
-                for i in (0..k).filter(|&i| live(i)) {
-                    w[i] = (0..k)
-                        .filter(|&j| j != i && live(j))
-                        .map(|j| {
-                            win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda)
-                        })
-                        .product();
-                }
+                return mix_max_weights(lookups, &moments, *contrast, *lambda);
             }
         }
-        let sum: f32 = w[..k].iter().sum();
-        if sum > 0.0 {
-            w.iter_mut().for_each(|x| *x /= sum);
-        } else {
-            // Every tile lost every duel (ties at zero spread): fall back to the paving.
-            for i in 0..k {
-                w[i] = lookups[i].weight;
-            }
-        }
-        w
+        normalised(w, lookups)
     }
 
     /// Bytes held by the operator's maps.
@@ -198,6 +190,52 @@ fn win_probability(difference: f32, variance: f32) -> f32 {
     } else {
         0.5
     }
+}
+
+/// Mix-Max's weights (see [`Blend::MixMax`]) of the tiles `lookups`, whose priority maps read
+/// `moments` (mean and variance over each tile's footprint): each pair of live tiles duels once,
+/// the winner's probability p multiplying one weight and 1 - p the other; normalised.
+pub(super) fn mix_max_weights(
+    lookups: &[TileLookup],
+    moments: &[(f32, f32)],
+    contrast: f32,
+    lambda: f32,
+) -> [f32; MAX_LOOKUPS] {
+    let k = lookups.len();
+    let mut score = [f32::NEG_INFINITY; MAX_LOOKUPS];
+    let mut variance = [0.0; MAX_LOOKUPS];
+    let mut w = [0.0; MAX_LOOKUPS];
+    // Tiles of weight 0 (outside a cut band's reach) take no part.
+    let live = |i: usize| lookups[i].weight > 0.0;
+    for i in (0..k).filter(|&i| live(i)) {
+        let (s, var) = moments[i];
+        score[i] = contrast * s + lookups[i].weight.ln();
+        variance[i] = contrast * contrast * var;
+        w[i] = 1.0;
+    }
+    for i in (0..k).filter(|&i| live(i)) {
+        for j in (i + 1..k).filter(|&j| live(j)) {
+            let p = win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda);
+            w[i] *= p;
+            w[j] *= 1.0 - p;
+        }
+    }
+    normalised(w, lookups)
+}
+
+/// Weights `w` of `lookups` divided by their sum; the paving's weights where every tile lost
+/// every duel (ties at zero spread).
+fn normalised(mut w: [f32; MAX_LOOKUPS], lookups: &[TileLookup]) -> [f32; MAX_LOOKUPS] {
+    let k = lookups.len();
+    let sum: f32 = w[..k].iter().sum();
+    if sum > 0.0 {
+        w.iter_mut().for_each(|x| *x /= sum);
+    } else {
+        for i in 0..k {
+            w[i] = lookups[i].weight;
+        }
+    }
+    w
 }
 
 /// m + sum w_i (v_i - m) / sqrt(sum w_i^2).

@@ -298,7 +298,7 @@ impl TilingBlending {
             Blend::Sharpened { .. } => return Err("the sharpened operator is not ported to the GPU".into()),
         };
         let (exemplar, inverse_tables) = match &self.exemplar {
-            Exemplar::Plain { texture, mean } => {
+            Exemplar::Plain { texture, mean, .. } => {
                 let crate::texture::Texture::Image(image) = texture.as_ref() else {
                     return Err("the GPU port reads image exemplars only".into());
                 };

@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""tessera against Mitsuba 3 in one session: samples per second, alternating, medians, ratios.
+
+    python3 reference/bench.py [--rounds 3] [--threads 2] [--scenes A,D]
+
+Scenes: A is scenes/brushed_metal.toml (the render benchmark of `tessera bench`); D is
+scenes/bench_deformed.toml (deformed tiling and blending with Mix-Max, an F map and cut bands,
+evaluated procedurally by tessera; Mitsuba renders `tessera export-mitsuba`'s bake of it).
+
+Each round renders each scene once with tessera, once with Mitsuba's llvm_ad_rgb and once with
+its scalar_rgb, one after the other, so that a machine that slows down or speeds up during the
+session affects all three alike; the medians over the rounds are printed with their ratios.
+Rendering time only, for both: tessera's own figure (`tessera render` prints the samples per
+second of its rendering, after loading), and Mitsuba's `mi.render` timed around (after loading,
+and after one warm-up render that compiles the LLVM kernels). Mitsuba comes from the virtual
+environment of reference/generate.sh (VENV, default ~/.venv-tessera-mitsuba); without it only
+tessera is measured. Builds tessera in release mode first.
+"""
+import argparse
+import os
+import re
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENES = {"A": "scenes/brushed_metal.toml", "D": "scenes/bench_deformed.toml"}
+VARIANTS = ("llvm_ad_rgb", "scalar_rgb")
+
+
+def tessera_rate(tessera, scene, threads, out):
+    """tessera's samples per second (millions) rendering `scene`, as it reports them."""
+    run = subprocess.run(
+        [tessera, "render", scene, "--threads", str(threads), "-o", out],
+        cwd=ROOT, capture_output=True, text=True, check=True,
+    )
+    found = re.search(r"\(([0-9.]+) M samples/s\)", run.stdout + run.stderr)
+    if not found:
+        sys.exit(f"bench.py: no samples/s in tessera's output for {scene}:\n{run.stdout}{run.stderr}")
+    return float(found.group(1))
+
+
+def mitsuba_rate(python, xml, variant, threads):
+    """Mitsuba's samples per second (millions) rendering `xml` with `variant` (one warm-up)."""
+    run = subprocess.run(
+        [python, str(ROOT / "reference/time_mitsuba.py"), xml, "--variant", variant, "--runs", "1",
+         "--warmup", "1", "--threads", str(threads)],
+        cwd=ROOT, capture_output=True, text=True, check=True,
+    )
+    return float(run.stdout.split()[1])
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--rounds", type=int, default=3, help="alternating rounds (the median is printed)")
+    parser.add_argument("--threads", type=int, default=2, help="threads of every renderer")
+    parser.add_argument("--scenes", default="A,D", help="which scenes, comma separated: A, D")
+    args = parser.parse_args()
+    if args.rounds < 1:
+        sys.exit("bench.py: --rounds must be at least 1")
+    names = args.scenes.split(",")
+    for name in names:
+        if name not in SCENES:
+            sys.exit(f"bench.py: unknown scene {name!r} (A or D)")
+
+    subprocess.run(["cargo", "build", "--release", "--quiet"], cwd=ROOT, check=True)
+    tessera = str(ROOT / "target/release/tessera")
+    venv = Path(os.environ.get("VENV", Path.home() / ".venv-tessera-mitsuba"))
+    python = venv / "bin/python"
+    have_mitsuba = python.exists()
+    if not have_mitsuba:
+        print(f"bench.py: no Mitsuba virtual environment at {venv} (reference/generate.sh makes one); tessera only")
+    out = ROOT / "target/bench"
+    out.mkdir(parents=True, exist_ok=True)
+
+    for name in names:
+        scene = SCENES[name]
+        xml = out / name / "scene.xml"
+        if have_mitsuba:
+            subprocess.run([tessera, "export-mitsuba", scene, "-o", str(out / name)], cwd=ROOT, check=True,
+                           capture_output=True)
+        rates = {"tessera": []} | ({v: [] for v in VARIANTS} if have_mitsuba else {})
+        for round_ in range(args.rounds):
+            rates["tessera"].append(tessera_rate(tessera, scene, args.threads, str(out / f"{name}.exr")))
+            if have_mitsuba:
+                for variant in VARIANTS:
+                    rates[variant].append(mitsuba_rate(str(python), str(xml), variant, args.threads))
+            print(f"scene {name} round {round_ + 1}: " + ", ".join(f"{k} {v[-1]:.3f}" for k, v in rates.items()),
+                  flush=True)
+        median = {k: statistics.median(v) for k, v in rates.items()}
+        print(f"scene {name} ({scene}), {args.threads} threads, medians of {args.rounds} rounds:")
+        for k, v in median.items():
+            ratio = "" if k == "tessera" else f"   tessera / {k} = {median['tessera'] / v:.2f}x"
+            print(f"  {k:<12} {v:7.3f} M samples/s{ratio}")
+
+
+if __name__ == "__main__":
+    main()
