@@ -120,6 +120,15 @@ impl EnvironmentMap {
         (pdf > 0.0).then_some((uv, pdf))
     }
 
+    /// Solid-angle density of sampling direction `d`, whose map coordinates are `uv`.
+    fn pdf_of(&self, d: Vec3, uv: Vec2) -> f32 {
+        let sin_theta = (1.0 - d.y * d.y).max(0.0).sqrt();
+        if sin_theta == 0.0 {
+            return 0.0;
+        }
+        self.pdf_uv(uv) / (2.0 * PI * PI * sin_theta)
+    }
+
     /// Density over the unit square of [`EnvironmentMap::sample_uv`] at (u, v).
     fn pdf_uv(&self, uv: Vec2) -> f32 {
         let (w, h) = (self.image.width, self.image.height.max(2));
@@ -150,27 +159,33 @@ impl Environment {
                 let wi = uv_to_direction(uv);
                 // The density as `pdf` computes it from the direction, so that MIS weights use one
                 // function (a sample on a cell edge may round into the neighbouring cell).
-                let pdf = self.pdf(wi);
+                let (radiance, pdf) = self.radiance_and_pdf(wi);
                 if pdf <= 0.0 {
                     return None;
                 }
-                (wi, pdf)
+                return Some(LightSample { wi, radiance, pdf, point: None, delta: false });
             }
         };
         Some(LightSample { wi, radiance: self.radiance(wi), pdf, point: None, delta: false })
+    }
+
+    /// [`Environment::radiance`] and [`Environment::pdf`] of `d` at once, mapping `d` to the
+    /// map's coordinates once.
+    pub fn radiance_and_pdf(&self, d: Vec3) -> (Rgb, f32) {
+        match self {
+            Environment::Constant(c) => (*c, warp::UNIFORM_SPHERE_PDF),
+            Environment::Map(m) => {
+                let uv = direction_to_uv(d);
+                (m.lookup_uv(uv), m.pdf_of(d, uv))
+            }
+        }
     }
 
     /// Solid-angle density of [`Environment::sample`] returning `d`.
     pub fn pdf(&self, d: Vec3) -> f32 {
         match self {
             Environment::Constant(_) => warp::UNIFORM_SPHERE_PDF,
-            Environment::Map(m) => {
-                let sin_theta = (1.0 - d.y * d.y).max(0.0).sqrt();
-                if sin_theta == 0.0 {
-                    return 0.0;
-                }
-                m.pdf_uv(direction_to_uv(d)) / (2.0 * PI * PI * sin_theta)
-            }
+            Environment::Map(m) => m.pdf_of(d, direction_to_uv(d)),
         }
     }
 }

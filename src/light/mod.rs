@@ -100,7 +100,13 @@ impl Lights {
             |light_pdf: f32| bsdf_pdf.map_or(1.0, |pdf| power_heuristic(pdf, light_pdf * self.selection_pdf()));
         let mut radiance = Rgb::ZERO;
         if let Some(env) = &self.environment {
-            radiance += env.radiance(d) * weight(env.pdf(d));
+            radiance += match bsdf_pdf {
+                Some(_) => {
+                    let (l, pdf) = env.radiance_and_pdf(d);
+                    l * weight(pdf)
+                }
+                None => env.radiance(d),
+            };
         }
         for sun in &self.distant {
             let l = sun.radiance(d);
