@@ -132,11 +132,14 @@ pub fn render_samples(
                 // packet (`Accel::intersect_many`); then each sample's path on its own.
                 for first in samples.clone().step_by(PACKET) {
                     let count = (samples.end - first).min(PACKET as u32) as usize;
-                    // Slots past `count` repeat the last sample, and are not traced.
-                    let batch: [_; PACKET] = std::array::from_fn(|k| camera_sample(first + k.min(count - 1) as u32));
-                    let rays = batch.each_ref().map(|b| b.0);
+                    // Only the first `count` slots hold samples (a pass of fewer samples than
+                    // PACKET makes no others); the other rays repeat the first, untraced.
+                    let batch: [_; PACKET] =
+                        std::array::from_fn(|k| (k < count).then(|| camera_sample(first + k as u32)));
+                    let first_ray = batch[0].as_ref().map(|b| b.0).expect("count is at least 1");
+                    let rays = batch.each_ref().map(|b| b.as_ref().map_or(first_ray, |b| b.0));
                     scene.accel.intersect_many(&rays[..count], &mut primary[..count]);
-                    for ((ray, diff, mut sampler), hit) in batch.into_iter().zip(primary).take(count) {
+                    for ((ray, diff, mut sampler), hit) in batch.into_iter().flatten().zip(primary) {
                         let mut first_hit = None;
                         let l = tracer.trace(ray, hit, &diff, &mut sampler, &mut first_hit);
                         aov_values(aovs, &first_hit, &mut aov_buf);

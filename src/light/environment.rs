@@ -98,7 +98,7 @@ impl EnvironmentMap {
         let y = (uv.y * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
         let (x0, y0) = (crate::math::floor(x), crate::math::floor(y));
         let (fx, fy) = (x - x0, y - y0);
-        let col = |c: f32| (c as i64).rem_euclid(w as i64) as usize;
+        let col = |c: f32| crate::math::wrap_index(c as i64, w);
         let (c0, c1) = (col(x0), col(x0 + 1.0));
         let r0 = y0 as usize;
         let r1 = (r0 + 1).min(h - 1);
@@ -132,7 +132,16 @@ impl EnvironmentMap {
     /// Density over the unit square of [`EnvironmentMap::sample_uv`] at (u, v).
     fn pdf_uv(&self, uv: Vec2) -> f32 {
         let (w, h) = (self.image.width, self.image.height.max(2));
-        let x = (uv.x * w as f32 - 0.5).rem_euclid(w as f32);
+        let x = uv.x * w as f32 - 0.5;
+        // x mod w; within one period of [0, w), as lookups are, without the division (the
+        // same value: the remainder of |x| < w is x).
+        let x = if (0.0..w as f32).contains(&x) {
+            x
+        } else if (-(w as f32)..0.0).contains(&x) {
+            x + w as f32
+        } else {
+            x.rem_euclid(w as f32)
+        };
         let y = (uv.y * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
         let (i, j) = ((x as usize).min(w - 1), (y as usize).min(h - 2));
         let p = Vec2::new(x - i as f32, y - j as f32);

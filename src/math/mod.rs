@@ -67,6 +67,22 @@ pub fn normal_cdf_f32(x: f32) -> f32 {
     if x >= 0.0 { 0.5 + 0.5 * erf } else { 0.5 - 0.5 * erf }
 }
 
+/// `i` modulo `n` in [0, n): texel indices of images that repeat. Lookups fall at most one
+/// period outside, where this avoids the division.
+#[inline(always)]
+pub fn wrap_index(i: i64, n: usize) -> usize {
+    let n = n as i64;
+    if (0..n).contains(&i) {
+        i as usize
+    } else if (-n..0).contains(&i) {
+        (i + n) as usize
+    } else if (n..2 * n).contains(&i) {
+        (i - n) as usize
+    } else {
+        i.rem_euclid(n) as usize
+    }
+}
+
 /// The standard normal cumulative distribution function Phi(x).
 #[inline]
 pub fn normal_cdf(x: f64) -> f64 {

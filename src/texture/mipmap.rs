@@ -4,7 +4,7 @@
 //! tiles of paper 001, each filtered on its own).
 
 use crate::image::Bitmap;
-use crate::math::{floor, floor2};
+use crate::math::{floor, floor2, wrap_index};
 use glam::{Vec2, Vec4};
 
 /// How an image texture is filtered over the hit's footprint.
@@ -104,21 +104,6 @@ fn downsample_axis(src: &Bitmap, new_len: usize, horizontal: bool) -> Bitmap {
     out
 }
 
-/// `i` modulo `n` in [0, n); lookups fall at most one texel outside, so avoid the division then.
-#[inline(always)]
-fn wrap(i: i64, n: usize) -> usize {
-    let n = n as i64;
-    if (0..n).contains(&i) {
-        i as usize
-    } else if (-n..0).contains(&i) {
-        (i + n) as usize
-    } else if (n..2 * n).contains(&i) {
-        (i - n) as usize
-    } else {
-        i.rem_euclid(n) as usize
-    }
-}
-
 /// The Gaussian weight of a texel at squared ellipse radius `r2` in [0, 1): the table
 /// interpolated linearly between its nodes r2 = i / (EWA_LUT_SIZE - 1), so that the weight is
 /// continuous in r2 and a GPU, whose r2 differs from the CPU's in the last bits, gives the same
@@ -215,7 +200,7 @@ impl MipMap {
     /// Column or row `i` of a level `n` texels long: wrapped, or clamped to the edge.
     #[inline(always)]
     fn index(&self, i: i64, n: usize) -> usize {
-        if self.clamp { i.clamp(0, n as i64 - 1) as usize } else { wrap(i, n) }
+        if self.clamp { i.clamp(0, n as i64 - 1) as usize } else { wrap_index(i, n) }
     }
 
     /// Bilinear interpolation of `level` at `st` (image coordinates in [0, 1]: x right, y down),
