@@ -161,21 +161,17 @@ impl Environment {
 
     /// Sample a direction towards the environment.
     pub fn sample(&self, u: Vec2) -> Option<LightSample> {
-        let (wi, pdf) = match self {
-            Environment::Constant(_) => (warp::square_to_uniform_sphere(u), warp::UNIFORM_SPHERE_PDF),
-            Environment::Map(m) => {
-                let (uv, _) = m.sample_uv(u)?;
-                let wi = uv_to_direction(uv);
-                // The density as `pdf` computes it from the direction, so that MIS weights use one
-                // function (a sample on a cell edge may round into the neighbouring cell).
-                let (radiance, pdf) = self.radiance_and_pdf(wi);
-                if pdf <= 0.0 {
-                    return None;
-                }
-                return Some(LightSample { wi, radiance, pdf, point: None, delta: false });
-            }
+        let wi = match self {
+            Environment::Constant(_) => warp::square_to_uniform_sphere(u),
+            Environment::Map(m) => uv_to_direction(m.sample_uv(u)?.0),
         };
-        Some(LightSample { wi, radiance: self.radiance(wi), pdf, point: None, delta: false })
+        // The density as `pdf` computes it from the direction, so that MIS weights use one
+        // function (a map sample on a cell edge may round into the neighbouring cell).
+        let (radiance, pdf) = self.radiance_and_pdf(wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(LightSample { wi, radiance, pdf, point: None, delta: false })
     }
 
     /// [`Environment::radiance`] and [`Environment::pdf`] of `d` at once, mapping `d` to the
