@@ -7,14 +7,15 @@ pub mod primary;
 mod progressive;
 
 pub use checkpoint::{Checkpoint, fingerprint};
-pub use path::{FirstHit, PathTracer};
+pub use path::{FirstHit, Path, PathTracer, WaveBuffers};
 pub use progressive::{Ending, PassLimits, render_in_passes};
 
 use crate::color::Rgb;
+use crate::geometry::Ray;
 use crate::image::{Aov, Film};
 use crate::sampling::PixelKey;
 use crate::scene::Scene;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -24,6 +25,10 @@ const TILE: u32 = 16;
 
 /// A pixel's camera rays are traced this many at a time, as a packet.
 const PACKET: usize = 8;
+
+/// About this many paths are traced as one wavefront ([`PathTracer::trace_wave`]): whole
+/// pixels' samples, at least one pixel's.
+const WAVE: usize = 256;
 
 /// A rectangle of pixels `[x0, x1) x [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -113,12 +118,19 @@ pub fn render_samples(
         let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
         let mut aov_buf = vec![0.0f32; stride];
         let mut primary = [None; PACKET];
-        for fy in ty * TILE..((ty + 1) * TILE).min(h) {
-            for fx in tx * TILE..((tx + 1) * TILE).min(w) {
+        let mut paths = Vec::new();
+        let mut buffers = WaveBuffers::default();
+        let tile_pixels: Vec<(u32, u32)> = (ty * TILE..((ty + 1) * TILE).min(h))
+            .flat_map(|fy| (tx * TILE..((tx + 1) * TILE).min(w)).map(move |fx| (fx, fy)))
+            .collect();
+        // Whole pixels at a time, about WAVE paths, are traced as one wavefront; then each
+        // pixel's samples are added to its sums in order.
+        let pixels_per_wave = (WAVE / samples.len().max(1)).max(1);
+        for wave in tile_pixels.chunks(pixels_per_wave) {
+            paths.clear();
+            for &(fx, fy) in wave {
                 let (px, py) = (crop.x0 + fx, crop.y0 + fy);
-                let pixel_index = py as u64 * s.width as u64 + px as u64;
-                let mut sum = film.pixel(fx as usize, fy as usize).clone();
-                let key = PixelKey::new(s.seed, pixel_index);
+                let key = PixelKey::new(s.seed, py as u64 * s.width as u64 + px as u64);
                 let camera_sample = |i: u32| {
                     let mut sampler = key.sampler(i);
                     let film_pos = s.pixel_filter.film_position(px, py, sampler.next_2d());
@@ -129,22 +141,30 @@ pub fn render_samples(
                     (ray, diff, sampler)
                 };
                 // The camera rays of up to PACKET samples at a time are traced together, as a
-                // packet (`Accel::intersect_many`); then each sample's path on its own.
+                // packet (`Accel::intersect_many`).
                 for first in samples.clone().step_by(PACKET) {
                     let count = (samples.end - first).min(PACKET as u32) as usize;
-                    // Only the first `count` slots hold samples (a pass of fewer samples than
-                    // PACKET makes no others); the other rays repeat the first, untraced.
-                    let batch: [_; PACKET] =
-                        std::array::from_fn(|k| (k < count).then(|| camera_sample(first + k as u32)));
-                    let first_ray = batch[0].as_ref().map(|b| b.0).expect("count is at least 1");
-                    let rays = batch.each_ref().map(|b| b.as_ref().map_or(first_ray, |b| b.0));
-                    scene.accel.intersect_many(&rays[..count], &mut primary[..count]);
-                    for ((ray, diff, mut sampler), hit) in batch.into_iter().flatten().zip(primary) {
-                        let mut first_hit = None;
-                        let l = tracer.trace(ray, hit, &diff, &mut sampler, &mut first_hit);
-                        aov_values(aovs, &first_hit, &mut aov_buf);
-                        sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), &aov_buf);
+                    let start = paths.len();
+                    // Only the first `count` slots are filled and traced.
+                    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+                    for (k, ray) in rays.iter_mut().enumerate().take(count) {
+                        let (camera_ray, diff, sampler) = camera_sample(first + k as u32);
+                        *ray = camera_ray;
+                        paths.push(tracer.start(camera_ray, diff, sampler));
                     }
+                    scene.accel.intersect_many(&rays[..count], &mut primary[..count]);
+                    for (path, hit) in paths[start..].iter_mut().zip(primary) {
+                        path.set_primary_hit(hit);
+                    }
+                }
+            }
+            tracer.trace_wave(&mut paths, &mut buffers);
+            for (&(fx, fy), pixel_paths) in wave.iter().zip(paths.chunks(samples.len().max(1))) {
+                let mut sum = film.pixel(fx as usize, fy as usize).clone();
+                for path in pixel_paths {
+                    let l = path.radiance;
+                    aov_values(aovs, &path.first_hit, &mut aov_buf);
+                    sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), &aov_buf);
                 }
                 pixels.push((fx as usize, fy as usize, sum));
             }

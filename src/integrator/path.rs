@@ -1,6 +1,14 @@
 //! The path tracer: unidirectional, with next-event estimation and multiple importance sampling
 //! (power heuristic) for the lights that paths can hit, and Russian roulette.
 //!
+//! Paths are traced as a wavefront: every path of a batch is shaded at its current vertex, then
+//! all their shadow rays are tested, then all their next rays are traced, and again, until
+//! every path has ended. Each path draws its random numbers in the order of a path traced
+//! alone and adds its terms to its radiance in that order (emission, then the light sample of
+//! the vertex, then the next vertex's emission), so that the image does not depend on how the
+//! paths are batched. Stages that see a batch of independent queries and shading points are
+//! where SIMD lanes apply (docs/design-decisions.md, "The wavefront").
+//!
 //! Path length follows Mitsuba 3's count: `max_depth` is the number of path segments, so 1
 //! shows only emitters seen directly and 2 adds direct lighting. Russian roulette starts once
 //! `rr_depth` segments are traced, continuing with probability min(max(throughput) eta^2, 0.95).
@@ -47,15 +55,60 @@ pub struct PathTracer<'a> {
 }
 
 /// How the previous vertex sampled the current ray, for MIS at the next emitter hit.
+#[derive(Clone, Copy, Debug)]
 struct PreviousVertex {
     p: Vec3,
     pdf: f32,
     delta: bool,
 }
 
+/// One path of a wavefront: where it is, what it carries, what it has gathered.
+#[derive(Clone, Debug)]
+pub struct Path {
+    /// The ray to the next vertex (the camera ray at first).
+    ray: Ray,
+    /// The camera ray's differentials (for the footprint at the first hit).
+    diff: RayDifferential,
+    /// The closest hit of `ray`, once traced.
+    hit: Option<Hit>,
+    sampler: Sampler,
+    throughput: Rgb,
+    eta_scale: f32,
+    prev: PreviousVertex,
+    /// Segments traced so far (0: the camera ray).
+    depth: u32,
+    /// Radiance gathered so far (all of it once the path has ended).
+    pub radiance: Rgb,
+    /// The camera ray's first hit, where the tracer records first hits and the ray hit something.
+    pub first_hit: Option<FirstHit>,
+}
+
+impl Path {
+    /// Set the closest hit of the camera ray (the renderer traces a pixel's camera rays
+    /// together, as a packet).
+    pub fn set_primary_hit(&mut self, hit: Option<Hit>) {
+        self.hit = hit;
+    }
+}
+
+/// A light sample waiting for its shadow ray: the path it belongs to and what it adds.
+struct ShadowTest {
+    path: usize,
+    ray: Ray,
+    contribution: Rgb,
+}
+
+/// The buffers of [`PathTracer::trace_wave`], kept from one wave to the next.
+#[derive(Default)]
+pub struct WaveBuffers {
+    active: Vec<usize>,
+    shadow: Vec<ShadowTest>,
+}
+
 impl<'a> PathTracer<'a> {
-    /// A tracer with the scene's settings; `record_first_hit` fills `trace`'s `first_hit`, and
-    /// `record_footprint` computes its texture footprint even where no filtered texture needs it.
+    /// A tracer with the scene's settings; `record_first_hit` fills each path's `first_hit`,
+    /// and `record_footprint` computes its texture footprint even where no filtered texture
+    /// needs it.
     pub fn new(scene: &'a Scene, record_first_hit: bool, record_footprint: bool) -> Self {
         let needs_footprint = scene
             .materials
@@ -72,129 +125,151 @@ impl<'a> PathTracer<'a> {
         }
     }
 
-    /// Radiance arriving along the camera ray `ray` (with differentials `diff`), whose closest
-    /// hit is `primary` (the renderer traces a pixel's camera rays together, as a packet);
-    /// `first_hit` is filled where the tracer records first hits and the ray hits something.
-    pub fn trace(
-        &self,
-        mut ray: Ray,
-        primary: Option<Hit>,
-        diff: &RayDifferential,
-        sampler: &mut Sampler,
-        first_hit: &mut Option<FirstHit>,
-    ) -> Rgb {
-        let scene = self.scene;
-        let lights = &scene.lights;
-        let mut radiance = Rgb::ZERO;
-        let mut throughput = Rgb::ONE;
-        let mut eta_scale = 1.0f32;
-        // The camera "samples" its ray with a delta: emitters seen directly get full weight.
-        let mut prev = PreviousVertex { p: ray.o, pdf: 1.0, delta: true };
-        let mut depth = 0u32;
-        loop {
-            let hit = if depth == 0 { primary } else { scene.accel.intersect(&ray) };
-            let Some(hit) = hit else {
-                let bsdf_pdf = (!prev.delta).then_some(prev.pdf);
-                radiance += throughput * lights.arriving_from_infinity(ray.d.normalize(), bsdf_pdf);
-                break;
-            };
-            let mut si = scene.interaction(&ray, &hit);
-            let shape = scene.shape_of(si.primitive);
+    /// A path that starts with the camera ray `ray` (differentials `diff`), drawing its random
+    /// numbers from `sampler`; its closest hit is set by [`Path::set_primary_hit`].
+    pub fn start(&self, ray: Ray, diff: RayDifferential, sampler: Sampler) -> Path {
+        Path {
+            ray,
+            diff,
+            hit: None,
+            sampler,
+            throughput: Rgb::ONE,
+            eta_scale: 1.0,
+            // The camera "samples" its ray with a delta: emitters seen directly get full weight.
+            prev: PreviousVertex { p: ray.o, pdf: 1.0, delta: true },
+            depth: 0,
+            radiance: Rgb::ZERO,
+            first_hit: None,
+        }
+    }
 
-            if let Some(light) = shape.light {
-                let emitted = lights.area[light as usize].emitted(si.ng, si.wo);
-                if emitted != Rgb::ZERO {
-                    let w = if prev.delta {
-                        1.0
-                    } else {
-                        power_heuristic(prev.pdf, lights.area_pdf(light as usize, prev.p, -si.wo, si.p, si.ng))
-                    };
-                    radiance += throughput * emitted * w;
+    /// Trace every path of `paths` to its end: shade all at their vertices, test all their
+    /// shadow rays, trace all their next rays, and again.
+    pub fn trace_wave(&self, paths: &mut [Path], buffers: &mut WaveBuffers) {
+        let WaveBuffers { active, shadow } = buffers;
+        active.clear();
+        active.extend(0..paths.len());
+        while !active.is_empty() {
+            shadow.clear();
+            active.retain(|&i| self.shade(i, &mut paths[i], shadow));
+            for test in shadow.iter() {
+                if !self.scene.occluded(&test.ray) {
+                    paths[test.path].radiance += test.contribution;
                 }
             }
-            if depth + 1 >= self.max_depth {
-                break;
-            }
-
-            // Texture footprint, where a filtered texture needs it: from the camera ray's
-            // differentials at the first hit, from the camera-based approximation after (pbrt-v4).
-            let wants_footprint =
-                self.needs_footprint[shape.material as usize] || (depth == 0 && self.record_footprint);
-            if wants_footprint && (depth > 0 || !si.footprint_from_differential(ray.o, diff)) {
-                let (dpdx, dpdy) = scene.camera.approximate_dp_dxy(si.p, si.ng);
-                si.set_footprint(dpdx, dpdy);
-            }
-            let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) };
-            let material = &scene.materials[shape.material as usize];
-            let bsdf = material.bsdf(&scene.textures, &ctx);
-            // Two-sided materials see the back as the front: mirror the local z axis to the
-            // viewer's side (Mitsuba's `twosided`), before any normal map perturbs the frame.
-            let mut base = si.frame;
-            if material.two_sided && base.n.dot(si.wo) < 0.0 {
-                base = Frame { n: -base.n, ..base };
-            }
-            let shading = material.shading(&scene.textures, &ctx, base, si.dpdu, si.dpdv);
-            let frame = shading.frame;
-            let wo = frame.to_local(si.wo);
-            if depth == 0 && self.record_first_hit {
-                *first_hit = Some(FirstHit {
-                    albedo: bsdf.albedo(),
-                    normal: frame.n,
-                    uv: si.uv,
-                    footprint: si.duv_dx.abs().max(si.duv_dy.abs()).max_element(),
-                    position: si.p,
-                    depth: si.p.distance(ray.o),
-                });
-            }
-
-            // Next-event estimation.
-            let u_light = sampler.next_1d();
-            let u_light2 = sampler.next_2d();
-            if !bsdf.is_delta() {
-                if let Some(ls) = lights.sample(si.p, u_light, u_light2) {
-                    let wi = frame.to_local(ls.wi);
-                    let f = bsdf.eval(wo, wi) * shading.light_factor(ls.wi);
-                    if f != Rgb::ZERO && ls.pdf > 0.0 {
-                        let shadow = match ls.point {
-                            Some(q) => si.spawn_ray_to(q),
-                            None => si.spawn_ray(ls.wi),
-                        };
-                        if !scene.occluded(&shadow) {
-                            let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf.pdf(wo, wi)) };
-                            radiance += throughput * f * ls.radiance * (w / ls.pdf);
-                        }
-                    }
-                }
-            }
-
-            // Continue the path by sampling the BSDF.
-            let u_lobe = sampler.next_1d();
-            let u_dir = sampler.next_2d();
-            let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
-                break;
-            };
-            let wi = frame.to_world(bs.wi);
-            let factor = shading.light_factor(wi);
-            if factor == 0.0 {
-                break;
-            }
-            throughput *= bs.weight * factor;
-            eta_scale *= bs.eta;
-            prev = PreviousVertex { p: si.p, pdf: bs.pdf, delta: bs.delta };
-            ray = si.spawn_ray(wi);
-            depth += 1;
-
-            if depth >= self.rr_depth {
-                let q = (throughput.max_element() * eta_scale * eta_scale).min(RR_MAX_PROBABILITY);
-                if sampler.next_1d() >= q {
-                    break;
-                }
-                throughput /= q;
-            }
-            if throughput.max_element() <= 0.0 {
-                break;
+            for &i in active.iter() {
+                paths[i].hit = self.scene.accel.intersect(&paths[i].ray);
             }
         }
-        radiance
+    }
+
+    /// Shade path `index` at the hit of its ray: add what it sees there, queue its light
+    /// sample's shadow test, and sample its next ray. False when the path ends here.
+    fn shade(&self, index: usize, path: &mut Path, shadow: &mut Vec<ShadowTest>) -> bool {
+        let scene = self.scene;
+        let lights = &scene.lights;
+        let Path { ray, diff, hit, sampler, throughput, eta_scale, prev, depth, radiance, first_hit } = path;
+        let Some(hit) = *hit else {
+            let bsdf_pdf = (!prev.delta).then_some(prev.pdf);
+            *radiance += *throughput * lights.arriving_from_infinity(ray.d.normalize(), bsdf_pdf);
+            return false;
+        };
+        let mut si = scene.interaction(ray, &hit);
+        let shape = scene.shape_of(si.primitive);
+
+        if let Some(light) = shape.light {
+            let emitted = lights.area[light as usize].emitted(si.ng, si.wo);
+            if emitted != Rgb::ZERO {
+                let w = if prev.delta {
+                    1.0
+                } else {
+                    power_heuristic(prev.pdf, lights.area_pdf(light as usize, prev.p, -si.wo, si.p, si.ng))
+                };
+                *radiance += *throughput * emitted * w;
+            }
+        }
+        if *depth + 1 >= self.max_depth {
+            return false;
+        }
+
+        // Texture footprint, where a filtered texture needs it: from the camera ray's
+        // differentials at the first hit, from the camera-based approximation after (pbrt-v4).
+        let wants_footprint = self.needs_footprint[shape.material as usize] || (*depth == 0 && self.record_footprint);
+        if wants_footprint && (*depth > 0 || !si.footprint_from_differential(ray.o, diff)) {
+            let (dpdx, dpdy) = scene.camera.approximate_dp_dxy(si.p, si.ng);
+            si.set_footprint(dpdx, dpdy);
+        }
+        let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) };
+        let material = &scene.materials[shape.material as usize];
+        let bsdf = material.bsdf(&scene.textures, &ctx);
+        // Two-sided materials see the back as the front: mirror the local z axis to the
+        // viewer's side (Mitsuba's `twosided`), before any normal map perturbs the frame.
+        let mut base = si.frame;
+        if material.two_sided && base.n.dot(si.wo) < 0.0 {
+            base = Frame { n: -base.n, ..base };
+        }
+        let shading = material.shading(&scene.textures, &ctx, base, si.dpdu, si.dpdv);
+        let frame = shading.frame;
+        let wo = frame.to_local(si.wo);
+        if *depth == 0 && self.record_first_hit {
+            *first_hit = Some(FirstHit {
+                albedo: bsdf.albedo(),
+                normal: frame.n,
+                uv: si.uv,
+                footprint: si.duv_dx.abs().max(si.duv_dy.abs()).max_element(),
+                position: si.p,
+                depth: si.p.distance(ray.o),
+            });
+        }
+
+        // Next-event estimation: the light sample's contribution, added if its shadow ray is
+        // clear.
+        let u_light = sampler.next_1d();
+        let u_light2 = sampler.next_2d();
+        if !bsdf.is_delta() {
+            if let Some(ls) = lights.sample(si.p, u_light, u_light2) {
+                let wi = frame.to_local(ls.wi);
+                let f = bsdf.eval(wo, wi) * shading.light_factor(ls.wi);
+                if f != Rgb::ZERO && ls.pdf > 0.0 {
+                    let ray = match ls.point {
+                        Some(q) => si.spawn_ray_to(q),
+                        None => si.spawn_ray(ls.wi),
+                    };
+                    let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf.pdf(wo, wi)) };
+                    shadow.push(ShadowTest {
+                        path: index,
+                        ray,
+                        contribution: *throughput * f * ls.radiance * (w / ls.pdf),
+                    });
+                }
+            }
+        }
+
+        // Continue the path by sampling the BSDF.
+        let u_lobe = sampler.next_1d();
+        let u_dir = sampler.next_2d();
+        let Some(bs) = bsdf.sample(wo, u_lobe, u_dir) else {
+            return false;
+        };
+        let wi = frame.to_world(bs.wi);
+        let factor = shading.light_factor(wi);
+        if factor == 0.0 {
+            return false;
+        }
+        *throughput *= bs.weight * factor;
+        *eta_scale *= bs.eta;
+        *prev = PreviousVertex { p: si.p, pdf: bs.pdf, delta: bs.delta };
+        *ray = si.spawn_ray(wi);
+        *depth += 1;
+
+        if *depth >= self.rr_depth {
+            let q = (throughput.max_element() * *eta_scale * *eta_scale).min(RR_MAX_PROBABILITY);
+            if sampler.next_1d() >= q {
+                return false;
+            }
+            *throughput /= q;
+        }
+        // (NaN throughput goes on, as it always has: the film counts the sample as invalid.)
+        !(throughput.max_element() <= 0.0)
     }
 }
