@@ -6,15 +6,17 @@ mod common;
 use std::sync::atomic::AtomicBool;
 use tessera::image::Aov;
 use tessera::image::write_image;
-use tessera::integrator::{Crop, Ending, PassLimits, render, render_in_passes, render_samples};
+use tessera::integrator::{
+    Crop, Ending, PassLimits, Path, PathTracer, WaveBuffers, render, render_in_passes, render_samples,
+};
+use tessera::sampling::PixelKey;
 
-#[test]
-fn exr_is_bit_identical_with_one_and_two_threads() {
+/// A 24 x 20 scene with everything that draws random numbers: area light and environment map
+/// sampling, textures with every filter, glass, plastic, metal, glTF-style PBR and a normal map,
+/// an emitting exact sphere, and Gaussian pixel filtering (samples around each pixel's centre).
+fn everything_scene() -> String {
     let root = common::repo().join("scenes");
-    // Everything that draws random numbers: area light and environment map sampling, textures
-    // with every filter, glass, plastic, metal, glTF-style PBR and a normal map, an emitting
-    // exact sphere, and Gaussian pixel filtering (samples around each pixel's centre).
-    let toml = format!(
+    format!(
         r#"
         [render]
         width = 24
@@ -89,8 +91,12 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
         transform = [{{ scale = 0.5 }}, {{ lookat = {{ origin = [1, 3, 1], target = [0, 0, 0] }} }}]
         "#,
         root = root.display()
-    );
-    let (dir, scene) = common::scene(&toml, &[]);
+    )
+}
+
+#[test]
+fn exr_is_bit_identical_with_one_and_two_threads() {
+    let (dir, scene) = common::scene(&everything_scene(), &[]);
     let mut files = Vec::new();
     for threads in [1, 2, 1] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -135,4 +141,35 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
     let (film, spp, ending) = render_in_passes(&scene, crop, empty, limits, &never, &|_, _| {}, |_, _| Ok(())).unwrap();
     assert_eq!((spp, ending), (6, Ending::Complete));
     assert!(film.radiance().data == whole.radiance().data);
+}
+
+#[test]
+fn a_path_traced_in_a_wave_is_the_path_traced_alone() {
+    // The wavefront shades, shadow-tests and traces its paths stage by stage; each path's
+    // radiance and first hit must be what it gives traced on its own, bit for bit.
+    let (_dir, scene) = common::scene(&everything_scene(), &[]);
+    let tracer = PathTracer::new(&scene, true, true);
+    let start = |pixel: u32, sample: u32| -> Path {
+        let mut sampler = PixelKey::new(7, pixel as u64).sampler(sample);
+        let film = glam::Vec2::new((pixel % 24) as f32, (pixel / 24) as f32) + sampler.next_2d();
+        let (ray, diff) = scene.camera.generate_ray(film, glam::Vec2::ZERO);
+        let mut path = tracer.start(ray, diff, sampler);
+        path.set_primary_hit(scene.accel.intersect(&ray));
+        path
+    };
+    let starts: Vec<(u32, u32)> = (0..24 * 20).flat_map(|pixel| (0..3).map(move |sample| (pixel, sample))).collect();
+    let mut wave: Vec<Path> = starts.iter().map(|&(pixel, sample)| start(pixel, sample)).collect();
+    tracer.trace_wave(&mut wave, &mut WaveBuffers::default());
+    let bits = |path: &Path| {
+        let hit = path.first_hit.map(|h| (h.albedo.to_array(), h.normal.to_array(), h.uv.to_array(), h.depth));
+        (path.radiance.to_array().map(f32::to_bits), format!("{hit:?}"))
+    };
+    let mut lit = 0;
+    for (&(pixel, sample), together) in starts.iter().zip(&wave) {
+        let mut alone = [start(pixel, sample)];
+        tracer.trace_wave(&mut alone, &mut WaveBuffers::default());
+        assert_eq!(bits(&alone[0]), bits(together), "pixel {pixel}, sample {sample}");
+        lit += (together.radiance.max_element() > 0.0) as u32;
+    }
+    assert!(lit > 1000, "only {lit} of {} paths gathered light", wave.len());
 }
