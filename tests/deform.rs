@@ -109,6 +109,27 @@ fn degenerate_triangles_are_counted_and_filled() {
 }
 
 #[test]
+fn uv_area_outside_the_square_is_measured_and_a_mesh_mostly_outside_is_refused() {
+    // The strip spans u from 0.05 to 0.05 plus its arc length (about 0.8), v from 0.05 to
+    // 0.85: inside the square, as a map needs it. Its UV area is a rectangle.
+    let mesh = cylinder_strip(1.0);
+    let u_end = mesh.uvs.as_ref().unwrap().iter().map(|u| u.x).fold(0.0, f32::max) as f64;
+    let shifted = |du: f32| {
+        let mut mesh = mesh.clone();
+        mesh.uvs.as_mut().unwrap().iter_mut().for_each(|u| u.x += du);
+        deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 64, 0.25)
+    };
+    assert_eq!(shifted(0.0).unwrap().outside_square, 0.0);
+    // Moved right by 0.3: the part beyond u = 1 is reported.
+    let partly = shifted(0.3).unwrap().outside_square;
+    let expected = (u_end + 0.3 - 1.0) / (u_end - 0.05);
+    assert!((partly - expected).abs() < 1e-4, "{partly} against {expected}");
+    // Moved by a whole period (a UDIM tile): refused, saying why.
+    let error = shifted(1.0).unwrap_err();
+    assert!(error.contains("outside the unit square"), "{error}");
+}
+
+#[test]
 fn cli_writes_the_f_map_and_pictures() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("strip.obj"), common::obj_text(&cylinder_strip(1.0))).unwrap();

@@ -74,6 +74,16 @@ impl MeshArgs {
                 maps.degenerate
             );
         }
+        // Slivers just beyond the edge are common in artists' UVs (Spot: 0.13%, the lat-long
+        // smiley: 0.94%, whose excess wraps onto its own meridian); more is a layout error.
+        if maps.outside_square > 0.01 {
+            eprintln!(
+                "warning: {}: {:.2}% of the UV area lies outside the unit square [0, 1]^2, which the F map spans: \
+                 lookups there wrap into the square and read the field of another part of the surface",
+                self.mesh.display(),
+                100.0 * maps.outside_square
+            );
+        }
         let overlap = maps.overlap();
         if overlap.overlapped > 0 {
             eprintln!(

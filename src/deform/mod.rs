@@ -19,7 +19,7 @@ pub use distortion::{Distortion, distortion};
 pub use field::{ChartField, FieldSample, TriangleRaster};
 
 pub use gradient::{TriangleDeformation, deformation_gradient};
-pub use overlap::{UvOverlap, uv_coverage, uv_overlap};
+pub use overlap::{UvOverlap, uv_area_outside_square, uv_coverage, uv_overlap};
 
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
@@ -110,7 +110,15 @@ pub struct DeformationMaps {
     /// How many UV triangles cover each texel centre of the maps ([`uv_coverage`]; row 0 at
     /// v = 0).
     pub coverage: Vec<u8>,
+    /// The fraction of the UV area outside the unit square, where the maps hold no field
+    /// ([`uv_area_outside_square`]; at most [`MAX_OUTSIDE_SQUARE`]).
+    pub outside_square: f64,
 }
+
+/// The largest fraction of a mesh's UV area outside the unit square that [`deformation_maps`]
+/// accepts (with a warning from `tessera deform`): beyond it, lookups on most of the surface
+/// would wrap into the square and read the field of another part of it.
+pub const MAX_OUTSIDE_SQUARE: f64 = 0.5;
 
 impl DeformationMaps {
     /// The chart of the triangle each texel of the maps takes F from (row-major from the
@@ -201,6 +209,14 @@ pub fn deformation_maps(
             Some((FieldSample { direction: Vec2::from_angle(theta), stretch: d.stretch }, d.mirrored()))
         })
         .collect();
+    let outside_square = uv_area_outside_square(&uv_triangles);
+    if outside_square > MAX_OUTSIDE_SQUARE {
+        return Err(format!(
+            "{:.1}% of the UV area lies outside the unit square [0, 1]^2, which the F map spans: move the UV \
+             islands into it (UDIM tiles and islands moved by whole periods are not followed)",
+            100.0 * outside_square
+        ));
+    }
     let field = ChartField::new(mesh, &samples, rounds).ok_or("every triangle is degenerate")?;
     // Overlapping islands: the unmirrored one's field is kept; the renderer mirrors it for the
     // other (DeformationField::at_surface).
@@ -220,7 +236,7 @@ pub fn deformation_maps(
     let coverage = uv_coverage(&uv_triangles, res);
     let cuts = Cuts::new(mesh);
     let bands = CutBands::new(cuts.curves(&field, &uv_triangles), &f_map, tile_size)?;
-    Ok(DeformationMaps { field, raster, f_map, cuts, bands, degenerate, mirrored, coverage })
+    Ok(DeformationMaps { field, raster, f_map, cuts, bands, degenerate, mirrored, coverage, outside_square })
 }
 
 /// Pictures of an F map for people to look at: log2 |det F| as grey (0.5 at 1, black at 1/16,

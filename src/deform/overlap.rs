@@ -1,7 +1,9 @@
-//! Overlapping UV islands: the part of the UV square that more than one triangle covers. An F
-//! map has one value per texel, so where two parts of the surface share texels (mirrored or
-//! stacked islands) one of them gets the other's deformation; `tessera deform` warns with this
-//! fraction.
+//! How a mesh's UV triangles cover the UV square, which an F map spans. Overlapping UV islands:
+//! the part of the square that more than one triangle covers. An F map has one value per texel,
+//! so where two parts of the surface share texels (mirrored or stacked islands) one of them gets
+//! the other's deformation; `tessera deform` warns with this fraction. UV area outside the
+//! square: the map holds no field there (UDIM tiles, islands moved by whole periods), and
+//! `deform` warns or refuses ([`uv_area_outside_square`]).
 //!
 //! Coverage is counted at texel centres of an `n` x `n` grid over the UV square. Each triangle
 //! adds, on every row it crosses, one to the texels between its left and right edges, through a
@@ -80,6 +82,57 @@ pub fn uv_coverage(triangles: &[[Vec2; 3]], n: usize) -> Vec<u8> {
     counts
 }
 
+/// The fraction of the UV area of `triangles` that lies outside the unit square [0, 1]^2 (0 when
+/// their area is 0 or not finite): each triangle clipped to the square by its four sides
+/// (Sutherland-Hodgman), in f64.
+pub fn uv_area_outside_square(triangles: &[[Vec2; 3]]) -> f64 {
+    let (mut total, mut inside) = (0.0f64, 0.0f64);
+    for t in triangles {
+        let polygon: Vec<[f64; 2]> = t.iter().map(|p| [p.x as f64, p.y as f64]).collect();
+        let area = polygon_area(&polygon);
+        if !area.is_finite() {
+            continue;
+        }
+        total += area;
+        // The half-planes x >= 0, x <= 1, y >= 0, y <= 1 as (axis, side).
+        let clipped = [(0, 0.0), (0, 1.0), (1, 0.0), (1, 1.0)]
+            .iter()
+            .fold(polygon, |polygon, &(axis, side)| clip(&polygon, axis, side));
+        inside += polygon_area(&clipped);
+    }
+    if total > 0.0 { ((total - inside) / total).clamp(0.0, 1.0) } else { 0.0 }
+}
+
+/// Unsigned area of a polygon (shoelace).
+fn polygon_area(polygon: &[[f64; 2]]) -> f64 {
+    let n = polygon.len();
+    let twice: f64 = (0..n)
+        .map(|i| {
+            let (p, q) = (polygon[i], polygon[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum();
+    0.5 * twice.abs()
+}
+
+/// The part of `polygon` (convex) on the square's side of the line `p[axis] = side`: where
+/// p[axis] >= 0 for side 0, p[axis] <= 1 for side 1.
+fn clip(polygon: &[[f64; 2]], axis: usize, side: f64) -> Vec<[f64; 2]> {
+    let inside = |p: &[f64; 2]| if side == 0.0 { p[axis] >= 0.0 } else { p[axis] <= 1.0 };
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for (i, p) in polygon.iter().enumerate() {
+        let q = &polygon[(i + 1) % polygon.len()];
+        if inside(p) {
+            out.push(*p);
+        }
+        if inside(p) != inside(q) {
+            let t = (side - p[axis]) / (q[axis] - p[axis]);
+            out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+        }
+    }
+    out
+}
+
 /// The interval [left, right) of the horizontal line at height `y` inside triangle `t`, from
 /// the edges that straddle it (each edge's crossing computed from its endpoints in a fixed
 /// order, so that two triangles sharing the edge agree on it exactly).
@@ -131,5 +184,26 @@ mod tests {
         let huge = [[Vec2::splat(-1e6), Vec2::new(1e6, -1e6), Vec2::new(0.0, 1e6)]];
         assert_eq!(uv_overlap(&huge, 16), UvOverlap { covered: 256, overlapped: 0 });
         assert_eq!(uv_overlap(&[[Vec2::ZERO, Vec2::ONE, Vec2::ONE]], 16).covered, 0);
+    }
+
+    #[test]
+    fn uv_area_outside_the_square_is_measured_exactly() {
+        let inside = square(Vec2::splat(0.25), 0.5);
+        assert_eq!(uv_area_outside_square(&inside), 0.0);
+        // A square of side 0.5 straddling the right edge by 0.1: a fifth of it outside.
+        let straddling = square(Vec2::new(0.6, 0.2), 0.5);
+        assert!((uv_area_outside_square(&straddling) - 0.2).abs() < 1e-6);
+        // Moved by a whole period (a UDIM tile): all of it outside; a triangle over the square's
+        // corner, half outside along each axis: three quarters.
+        assert_eq!(uv_area_outside_square(&square(Vec2::new(1.25, 0.25), 0.5)), 1.0);
+        let corner = square(Vec2::splat(-0.5), 1.0);
+        assert!((uv_area_outside_square(&corner) - 0.75).abs() < 1e-6);
+        // Both together weigh by area; degenerate and non-finite triangles weigh nothing.
+        let mut both = inside.to_vec();
+        both.extend(square(Vec2::new(1.25, 0.25), 0.5));
+        both.push([Vec2::ZERO, Vec2::ONE, Vec2::ONE]);
+        both.push([Vec2::ZERO, Vec2::X, Vec2::splat(f32::NAN)]);
+        assert!((uv_area_outside_square(&both) - 0.5).abs() < 1e-12);
+        assert_eq!(uv_area_outside_square(&[]), 0.0);
     }
 }
