@@ -15,6 +15,21 @@ use crate::texture::tiling_blending::{CutCurve, CutPoint};
 use glam::Vec2;
 use std::collections::HashMap;
 
+/// What two cuts embedded at the same UVs share, whichever their direction and the order of
+/// their sides: each side's UVs (as bits) in the direction that starts at the lesser end, the
+/// two sides in order.
+fn uv_embedding(points: &[CutPoint]) -> [Vec<[u32; 2]>; 2] {
+    let side = |k: usize| {
+        let mut uvs: Vec<[u32; 2]> = points.iter().map(|p| p.uv[k].to_array().map(f32::to_bits)).collect();
+        if uvs.last() < uvs.first() {
+            uvs.reverse();
+        }
+        uvs
+    };
+    let (a, b) = (side(0), side(1));
+    if a <= b { [a, b] } else { [b, a] }
+}
+
 /// A point of a cut seen from both sides: its UVs on the left and the right side of the cut,
 /// and the surface length it stands for.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -191,8 +206,13 @@ impl Cuts {
     /// over its mean length in UV. Chains of zero length are left out, and so are chains of
     /// singular edges only (the fans around a lat-long pole: each edge a cut of its own whose
     /// band, through F's vanishing stretch along the pole's row, would cover the whole row).
+    /// A chain embedded at exactly the UVs of an earlier one (its twin on a stacked island: the
+    /// mirror-image half of a character, a repeated part) is left out too: the F map and the
+    /// bands' raster are keyed by UV, so the twin's hits read the first one's row (on the cut,
+    /// the same values from both sides), and twin bands would fill a texel's two band slots.
     pub fn curves(&self, field: &ChartField, uv_triangles: &[[Vec2; 3]]) -> Vec<CutCurve> {
         let mut curves = Vec::with_capacity(self.chains.len());
+        let mut embedded = std::collections::HashSet::new();
         for chain in &self.chains {
             if chain.iter().all(|&(e, _)| self.edges[e as usize].is_singular()) {
                 continue;
@@ -220,7 +240,7 @@ impl Cuts {
                 uv_length += (left[0].distance(left[1]) + right[0].distance(right[1])) / 2.0;
                 points.push(CutPoint { uv: [left[1], right[1]], s, g });
             }
-            if s > 0.0 && uv_length > 0.0 {
+            if s > 0.0 && uv_length > 0.0 && embedded.insert(uv_embedding(&points)) {
                 if let Ok(curve) = CutCurve::new(points, s / uv_length) {
                     curves.push(curve);
                 }
