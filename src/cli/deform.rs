@@ -184,8 +184,9 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     let fold =
         analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), args.tile_size, FieldAt::Point);
     if fold.folded > 0.01 {
-        // Tiles that read F at their centres are affine and fold only where islands overlap
-        // (a texel's chart is then one of several): say how much, rather than never.
+        // Tiles that read F at their centres are affine, and fold only where they fall back to
+        // F(u): no point of the texel's chart within a tile's reach of the centre, or islands
+        // that overlap. Say how much, rather than never.
         let charts = maps.chart_of_texels();
         let centres = analysis::fold_over(&maps.f_map, &maps.coverage, &charts, args.tile_size, FieldAt::TileCentre);
         eprintln!(

@@ -94,6 +94,10 @@ pub fn uv_area_outside_square(triangles: &[[Vec2; 3]]) -> f64 {
             continue;
         }
         total += area;
+        if t.iter().all(|p| (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y)) {
+            inside += area;
+            continue;
+        }
         // The half-planes x >= 0, x <= 1, y >= 0, y <= 1 as (axis, side).
         let clipped = [(0, 0.0), (0, 1.0), (1, 0.0), (1, 1.0)]
             .iter()
@@ -193,8 +197,8 @@ mod tests {
         // A square of side 0.5 straddling the right edge by 0.1: a fifth of it outside.
         let straddling = square(Vec2::new(0.6, 0.2), 0.5);
         assert!((uv_area_outside_square(&straddling) - 0.2).abs() < 1e-6);
-        // Moved by a whole period (a UDIM tile): all of it outside; a triangle over the square's
-        // corner, half outside along each axis: three quarters.
+        // Moved by a whole period (a UDIM tile): all of it outside; a square over the unit
+        // square's corner, half outside along each axis: three quarters.
         assert_eq!(uv_area_outside_square(&square(Vec2::new(1.25, 0.25), 0.5)), 1.0);
         let corner = square(Vec2::splat(-0.5), 1.0);
         assert!((uv_area_outside_square(&corner) - 0.75).abs() < 1e-6);
