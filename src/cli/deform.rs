@@ -181,13 +181,12 @@ fn print_distortion(classical: Option<Distortion>, deformed: Option<Distortion>)
 pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     let (mesh, maps, _, [loaded, computed]) = args.maps()?;
     // (`analyze` prints the fold-over among its figures.)
-    let fold =
-        analysis::fold_over(&maps.f_map, &maps.coverage, &maps.chart_of_texels(), args.tile_size, FieldAt::Point);
+    let charts = maps.chart_of_texels();
+    let fold = analysis::fold_over(&maps.f_map, &maps.coverage, &charts, args.tile_size, FieldAt::Point);
     if fold.folded > 0.01 {
         // Tiles that read F at their centres are affine, and fold only where they fall back to
         // F(u): no point of the texel's chart within a tile's reach of the centre, or islands
         // that overlap. Say how much, rather than never.
-        let charts = maps.chart_of_texels();
         let centres = analysis::fold_over(&maps.f_map, &maps.coverage, &charts, args.tile_size, FieldAt::TileCentre);
         eprintln!(
             "warning: {}: tiles of {} fold their lookups F(u)(u - c) on {:.1}% of the texels (F varies across a tile \
@@ -207,8 +206,13 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         write_exr(&staged.path().join(name), map.width, map.height, channels)
     };
     write_map("f_map.exr", &maps.f_map)?;
-    let charts = maps.chart_map();
-    write_exr(&staged.path().join("charts.exr"), charts.width, charts.height, vec![("Y".into(), charts.data)])?;
+    let chart_map = tessera::deform::chart_map_of(maps.raster.res, &charts);
+    write_exr(
+        &staged.path().join("charts.exr"),
+        chart_map.width,
+        chart_map.height,
+        vec![("Y".into(), chart_map.data)],
+    )?;
     let cuts_file = staged.path().join("cuts.json");
     std::fs::write(&cuts_file, cuts_to_json(maps.bands.curves())).map_err(|e| Error::io(&cuts_file, e))?;
     let (det, orientation_picture) = tessera::deform::f_map_pictures(&maps.f_map);

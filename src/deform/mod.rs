@@ -127,12 +127,6 @@ impl DeformationMaps {
         self.raster.owner.iter().map(|&t| self.field.chart_of_triangle[t as usize]).collect()
     }
 
-    /// The chart map: each texel's chart number as one channel, row 0 at the top (v = 1) as the
-    /// F map; the scene's `charts` for tiles that read F at their centres.
-    pub fn chart_map(&self) -> Bitmap {
-        chart_map_of(self.raster.res, &self.chart_of_texels())
-    }
-
     /// How much of the UV square more than one triangle covers, at the maps' resolution.
     pub fn overlap(&self) -> UvOverlap {
         UvOverlap::of_coverage(&self.coverage)
@@ -140,7 +134,8 @@ impl DeformationMaps {
 }
 
 /// The chart map of `charts` (a `res` x `res` raster's chart per texel, row-major from the bottom
-/// row, as [`DeformationMaps::chart_of_texels`] gives it): one channel, row 0 at the top (v = 1).
+/// row, as [`DeformationMaps::chart_of_texels`] gives it): one channel, row 0 at the top (v = 1)
+/// as the F map; the scene's `charts` for tiles that read F at their centres.
 pub fn chart_map_of(res: usize, charts: &[u32]) -> Bitmap {
     let mut map = Bitmap::new(res, res, 1);
     for (k, c) in charts.iter().enumerate() {
