@@ -9,7 +9,7 @@ use glam::{Mat2, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-use tessera::deform::analysis::seams;
+use tessera::deform::analysis::{frame_jumps, seams};
 use tessera::deform::{DeformationMaps, Orientation, Smoothing, deformation_maps};
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap};
@@ -385,4 +385,21 @@ fn pole_fans_are_singular_cuts_and_a_meridian_is_an_ordinary_one() {
         assert_eq!(edge.is_singular(), apart < 1e-6, "{edge:?}");
     }
     assert!(maps(&tube(0.9, 0.4, 0.0), 0.25).cuts.edges.iter().all(|e| !e.is_singular()));
+}
+
+#[test]
+fn the_texture_axis_hardly_turns_across_a_cut_between_charts_whose_fields_differ() {
+    // A fixed direction across the tube's axis turns against the tube as one goes round it, so
+    // the two charts' fields differ across the cut; each chart's vertices average only their
+    // own triangles, which left the two sides' texture axes J F^-1 e1 at an angle on the cut.
+    // Vertices on a cut now share one axis on the surface.
+    let mesh = two_chart_tube();
+    let m = deformation_maps(&mesh, &Orientation::Fixed(Vec3::new(1.0, 1.0, 0.0)), Smoothing::Vertices(1), 512, 0.03)
+        .unwrap();
+    let field = DeformationField::new(vec![Deformation::Map(MipMap::new(m.f_map.clone()))]);
+    let jumps = frame_jumps(&mesh, |uv, mirrored| field.at_surface(uv, Some(mirrored))).unwrap();
+    let (cuts, interior) = (jumps.cuts.unwrap(), jumps.interior.unwrap());
+    eprintln!("frame jumps: across the cuts {cuts:?}, inside the charts {interior:?}");
+    assert!(cuts.mean < 0.5 && cuts.p95 < 1.0, "{cuts:?}");
+    assert!(interior.mean < 0.5, "{interior:?}");
 }

@@ -315,6 +315,17 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
             e.mean, e.p95
         );
     }
+    if let Some(jumps) = a.frame_jumps {
+        let figure = |e: Option<analysis::AngleError>| {
+            e.map_or("n/a".to_string(), |e| format!("mean {:.2} degrees, 95th percentile {:.2}", e.mean, e.p95))
+        };
+        println!(
+            "frame jumps (the angle between the texture's x axis on an edge's two faces, unfolded, edge-length \
+             weighted): across cuts {}; inside charts {}",
+            figure(jumps.cuts),
+            figure(jumps.interior)
+        );
+    }
     if let Some(v) = a.lattice_visibility {
         println!(
             "lattice visibility (power at the paving's lattice frequencies over the exemplar's there, classical \

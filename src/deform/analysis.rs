@@ -9,6 +9,9 @@
 //!   Ordinary cuts and UV singularities (pole fans, darts) are reported apart.
 //! - **orientation error**: the angle between the texture's x axis on the surface, J F^-1 e1
 //!   (DESIGN.md section 3), and the orientation field, area-weighted mean and 95th percentile.
+//! - **frame jumps**: the angle between the texture's x axis on the two faces of each edge
+//!   (unfolded about it), apart for cut edges and for edges inside charts: what a brushed
+//!   highlight shows as a kink.
 //! - **fold-over**: where the lookup u -> F(u)(u - c) of a tile centred at c stops being
 //!   injective (its Jacobian F + dF (u - c) changes the sign of det F) or stretches by more than
 //!   2:1, for tile centres in every direction at a tile's distance (the paper's open "cracks").
@@ -17,7 +20,7 @@
 
 use super::fold::{DIRECTIONS, LookupFold, centred_fold, lookup_fold};
 use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion};
-use crate::geometry::TriangleMesh;
+use crate::geometry::{Topology, TriangleMesh};
 use crate::image::Bitmap;
 use crate::limits;
 use crate::texture::tiling_blending::{
@@ -82,6 +85,43 @@ pub struct AngleError {
     pub p95: f64,
 }
 
+impl AngleError {
+    /// The statistics of `(angle in degrees, weight)` pairs; None without weight.
+    fn of(mut angles: Vec<(f64, f64)>) -> Option<Self> {
+        let total: f64 = angles.iter().map(|a| a.1).sum();
+        if !(total > 0.0) {
+            return None;
+        }
+        let mean = angles.iter().map(|(a, w)| a * w).sum::<f64>() / total;
+        angles.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut below = 0.0;
+        let p95 = angles
+            .iter()
+            .find(|(_, w)| {
+                below += w;
+                below >= 0.95 * total
+            })
+            .map_or(0.0, |a| a.0);
+        Some(AngleError { mean, p95 })
+    }
+}
+
+/// The texture's x axis on the surface, J F^-1 e1 (DESIGN.md section 3), unit length, for the
+/// triangle with positions `x` and UVs `u` and F = `f`; None where either is degenerate.
+fn texture_axis(x: [Vec3; 3], u: [Vec2; 3], f: Mat2) -> Option<Vec3> {
+    let j = super::deformation_gradient(x, u)?;
+    if !(f.determinant().abs() > 1e-12) {
+        return None;
+    }
+    let axis_uv = f.inverse() * Vec2::X;
+    (j.x_axis * axis_uv.x + j.y_axis * axis_uv.y).try_normalize()
+}
+
+/// Whether a triangle's UVs are mirrored (clockwise).
+fn uv_mirrored(u: [Vec2; 3]) -> bool {
+    (u[1] - u[0]).perp_dot(u[2] - u[0]) < 0.0
+}
+
 /// The angle between the texture's x axis on the surface, J F^-1 e1 with F from `f_at` at each
 /// triangle's UV centroid (given whether the triangle's UVs are mirrored, as the renderer
 /// knows at a hit), and the orientation field's direction on each triangle. None for
@@ -97,35 +137,70 @@ pub fn orientation_error(
         let Some(o) = direction else { continue };
         let x = idx.map(|i| mesh.positions[i as usize]);
         let u = idx.map(|i| uvs[i as usize]);
-        let Some(j) = super::deformation_gradient(x, u) else { continue };
+        let Some(axis) = texture_axis(x, u, f_at((u[0] + u[1] + u[2]) / 3.0, uv_mirrored(u))) else { continue };
         let normal = (x[1] - x[0]).cross(x[2] - x[0]);
-        let mirrored = (u[1] - u[0]).perp_dot(u[2] - u[0]) < 0.0;
-        let f = f_at((u[0] + u[1] + u[2]) / 3.0, mirrored);
-        if !(f.determinant().abs() > 1e-12) {
-            continue;
-        }
-        let axis_uv = f.inverse() * Vec2::X;
-        let axis = j.x_axis * axis_uv.x + j.y_axis * axis_uv.y;
-        let along = (o - normal * o.dot(normal) / normal.length_squared()).try_normalize();
-        let (Some(along), Some(axis)) = (along, axis.try_normalize()) else { continue };
+        let Some(along) = (o - normal * o.dot(normal) / normal.length_squared()).try_normalize() else { continue };
         let angle = axis.dot(along).clamp(-1.0, 1.0).acos().to_degrees() as f64;
         angles.push((angle, normal.length() as f64 / 2.0));
     }
-    let total: f64 = angles.iter().map(|a| a.1).sum();
-    if !(total > 0.0) {
-        return None;
+    AngleError::of(angles)
+}
+
+/// How far the texture's x axis turns across the mesh's edges, apart for UV cuts and for
+/// edges inside charts.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FrameJumps {
+    /// Over the ordinary cut edges (not UV singularities); None without any.
+    pub cuts: Option<AngleError>,
+    /// Over the edges inside charts; None without any.
+    pub interior: Option<AngleError>,
+}
+
+/// The angle between the texture's x axis J F^-1 e1 on the two faces of each manifold edge, at
+/// the edge's middle (F from `f_at` at each face's UV of that point, given whether the face's
+/// UVs are mirrored), the second face's axis unfolded into the first face's plane about the
+/// edge: what a brushed highlight shows as a kink. Inside a chart F is continuous and the
+/// angle is the jump of the piecewise-linear UV map's Jacobian J between the faces; across a
+/// cut it adds the mismatch of the two charts' fields there. Weighted by edge length.
+pub fn frame_jumps(mesh: &TriangleMesh, f_at: impl Fn(Vec2, bool) -> Mat2) -> Option<FrameJumps> {
+    let uvs = mesh.uvs.as_ref()?;
+    let (welded, points) = mesh.welded_vertices();
+    let triangles: Vec<[u32; 3]> = mesh.indices.iter().map(|t| t.map(|i| welded[i as usize])).collect();
+    let topology = Topology::new(&triangles);
+    let (mut cuts, mut interior) = (Vec::new(), Vec::new());
+    for e in 0..topology.edge_count() {
+        let &[h0, h1] = topology.halves(e) else { continue };
+        let [a, b] = topology.edge_vertices(e);
+        // Each face's positions, UVs, and the UVs it gives the edge's endpoints a and b.
+        let face = |h: u32| {
+            let t = mesh.indices[topology.face_of(h as usize)];
+            let x = t.map(|i| mesh.positions[i as usize]);
+            let u = t.map(|i| uvs[i as usize]);
+            let at = |v: u32| (0..3).find(|&k| welded[t[k] as usize] == v).map(|k| u[k]);
+            (x, u, at(a).zip(at(b)))
+        };
+        let ((x0, u0, Some(ends0)), (x1, u1, Some(ends1))) = (face(h0), face(h1)) else { continue };
+        let singular = ends0.0.distance_squared(ends1.0) < 1e-12 || ends0.1.distance_squared(ends1.1) < 1e-12;
+        let cut = ends0.0.distance_squared(ends1.0) > 1e-12 || ends0.1.distance_squared(ends1.1) > 1e-12;
+        if cut && singular {
+            continue;
+        }
+        let axis = |x: [Vec3; 3], u: [Vec2; 3], ends: (Vec2, Vec2)| {
+            texture_axis(x, u, f_at((ends.0 + ends.1) / 2.0, uv_mirrored(u)))
+        };
+        let (Some(axis0), Some(axis1)) = (axis(x0, u0, ends0), axis(x1, u1, ends1)) else { continue };
+        // Unfold: the rotation about the edge taking face 1's normal to face 0's takes
+        // n1 x edge to n0 x edge.
+        let (pa, pb) = (points[a as usize], points[b as usize]);
+        let Some(edge) = (pb - pa).try_normalize() else { continue };
+        let normal = |x: [Vec3; 3]| (x[1] - x[0]).cross(x[2] - x[0]).try_normalize();
+        let (Some(n0), Some(n1)) = (normal(x0), normal(x1)) else { continue };
+        let unfolded = edge * axis1.dot(edge) + n0.cross(edge) * axis1.dot(n1.cross(edge));
+        let angle = axis0.dot(unfolded).clamp(-1.0, 1.0).acos().to_degrees() as f64;
+        let length = pa.distance(pb) as f64;
+        if cut { &mut cuts } else { &mut interior }.push((angle, length));
     }
-    let mean = angles.iter().map(|(a, w)| a * w).sum::<f64>() / total;
-    angles.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut below = 0.0;
-    let p95 = angles
-        .iter()
-        .find(|(_, w)| {
-            below += w;
-            below >= 0.95 * total
-        })
-        .map_or(0.0, |a| a.0);
-    Some(AngleError { mean, p95 })
+    Some(FrameJumps { cuts: AngleError::of(cuts), interior: AngleError::of(interior) })
 }
 
 /// Where tiles' lookups fold over or stretch.
@@ -245,6 +320,8 @@ pub struct Analysis {
     pub seam_samples: usize,
     /// Angle between the deformed texture's x axis and the orientation field.
     pub orientation_error: Option<AngleError>,
+    /// How far the deformed texture's x axis turns across cuts and across edges inside charts.
+    pub frame_jumps: Option<FrameJumps>,
     /// Fold-over of the tiles' lookups through the F map, read at the point (Eq. 3).
     pub fold_over: FoldOver,
     /// The same, the tiles reading F at their centres ([`FieldAt::TileCentre`]).
@@ -336,6 +413,7 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
         orientation_error: orientation_error(mesh, input.orientation, |uv, mirrored| {
             field.at_surface(uv, Some(mirrored))
         }),
+        frame_jumps: frame_jumps(mesh, |uv, mirrored| field.at_surface(uv, Some(mirrored))),
         // A hexagonal tile reaches one lattice spacing from its centre.
         fold_over: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::Point),
         fold_over_at_centres: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::TileCentre),

@@ -10,7 +10,7 @@
 
 use super::nearest::{NONE, distance2_to_segment, propagate_nearest};
 use crate::geometry::TriangleMesh;
-use glam::{Mat2, Vec2, Vec3};
+use glam::{Mat2, Mat3, Vec2, Vec3};
 use std::collections::HashMap;
 
 /// The orientation and stretch of the field at a point or a triangle.
@@ -137,6 +137,81 @@ impl ChartField {
         Some(ChartField { chart_of_triangle, charts, corners, vertex_samples, mirrored })
     }
 
+    /// Give the UV vertices of one position on a cut one direction on the surface, for an
+    /// orientation field given on the surface (not F = S, whose direction is the UV map's own).
+    /// Each chart's vertex averages only its own chart's triangles, so where the field or the
+    /// UV map varies across the cut, the two sides' texture axes J F^-1 e1 meet at an angle
+    /// there (a kink in a brushed highlight). Here each UV vertex's axis on the surface (J F^-1
+    /// e1 over its triangles, area-weighted) is averaged over all the UV vertices of its
+    /// position, and each takes the direction that its own triangles give that mean (Eq. 6
+    /// with the mean for the field's direction and each triangle's own stretch from `samples`,
+    /// which must be those of [`ChartField::new`], averaged as unit vectors like the vertex's
+    /// own samples); stretches stay per chart. Positions whose sides' axes differ by more than
+    /// 30 degrees keep their own directions: there the field turns fast (near its singular
+    /// points, or by 180 degrees on a mirrored half) and one mean would pull each side off its
+    /// neighbours.
+    pub fn share_directions_across_cuts(&mut self, mesh: &TriangleMesh, samples: &[TriangleSample]) {
+        let Some(uvs) = mesh.uvs.as_ref() else { return };
+        let vertices = self.vertex_samples.len();
+        let (welded, _) = mesh.welded_vertices();
+        let mut position_of_vertex = vec![0u32; vertices];
+        for (idx, c) in mesh.indices.iter().zip(&self.corners) {
+            (0..3).for_each(|k| position_of_vertex[c[k] as usize] = welded[idx[k] as usize]);
+        }
+        let mut at_position: HashMap<u32, Vec<u32>> = HashMap::new();
+        for v in 0..vertices as u32 {
+            at_position.entry(position_of_vertex[v as usize]).or_default().push(v);
+        }
+        at_position.retain(|_, vs| vs.len() > 1);
+        // Each triangle's Jacobian (d position / d uv, the unit normal as third column) and
+        // area, listed at its UV vertices with its own sample.
+        let mut triangles_of: Vec<Vec<(f32, Mat3, FieldSample, bool)>> = vec![Vec::new(); vertices];
+        for ((idx, c), sample) in mesh.indices.iter().zip(&self.corners).zip(samples) {
+            let x = idx.map(|i| mesh.positions[i as usize]);
+            let u = idx.map(|i| uvs[i as usize]);
+            if let (Some(j), Some((sample, mirrored))) = (super::deformation_gradient(x, u), sample) {
+                let area = (x[1] - x[0]).cross(x[2] - x[0]).length() / 2.0;
+                c.iter().for_each(|&v| triangles_of[v as usize].push((area, j, *sample, *mirrored)));
+            }
+        }
+        // The area-weighted sum of a UV vertex's texture axis over its triangles.
+        let axis_sum = |v: u32| -> Vec3 {
+            let s = self.vertex_samples[v as usize];
+            triangles_of[v as usize].iter().fold(Vec3::ZERO, |sum, &(area, j, _, mirrored)| {
+                let f = s.deformation(mirrored);
+                if !(f.determinant().abs() > 1e-20) {
+                    return sum;
+                }
+                let a = f.inverse() * Vec2::X;
+                sum + (j.x_axis * a.x + j.y_axis * a.y).normalize_or_zero() * area
+            })
+        };
+        let mut shared: Vec<(u32, Vec3)> = Vec::new();
+        for vs in at_position.values() {
+            let sums: Vec<Vec3> = vs.iter().map(|&v| axis_sum(v)).collect();
+            let agree =
+                sums.iter().all(|a| sums.iter().all(|b| a.dot(*b) > AGREEING_AXES_COS * a.length() * b.length()));
+            let mean = sums.iter().sum::<Vec3>();
+            if agree && mean.length_squared() > 0.0 {
+                shared.extend(vs.iter().map(|&v| (v, mean)));
+            }
+        }
+        for (v, mean) in shared {
+            // (cos theta, sin theta) with theta = -angle of [M] S J^+ d from e1 (Eq. 6): the
+            // vector [M] S J^+ d reflected in the u axis.
+            let direction = triangles_of[v as usize].iter().fold(Vec2::ZERO, |sum, &(area, j, sample, mirrored)| {
+                let mut local = sample.stretch * (j.inverse() * mean).truncate();
+                if mirrored {
+                    local.y = -local.y;
+                }
+                sum + Vec2::new(local.x, -local.y).normalize_or_zero() * area
+            });
+            if let Some(direction) = direction.try_normalize() {
+                self.vertex_samples[v as usize].direction = direction;
+            }
+        }
+    }
+
     /// F at the point of triangle `t` with barycentric coordinates `b` (clamped to the triangle).
     pub fn at(&self, t: usize, b: Vec3) -> Mat2 {
         let b = b.max(Vec3::ZERO);
@@ -158,6 +233,10 @@ impl ChartField {
         FieldSample { direction, stretch }.deformation(self.mirrored[t])
     }
 }
+
+/// [`ChartField::share_directions_across_cuts`] leaves a position alone where its sides'
+/// texture axes differ by more than this angle's cosine (30 degrees).
+const AGREEING_AXES_COS: f32 = 0.866_025_4;
 
 /// The connected components of triangles sharing a vertex: the chart of each triangle (numbered
 /// from 0 in order of first appearance) and their number.

@@ -212,7 +212,12 @@ pub fn deformation_maps(
             100.0 * outside_square
         ));
     }
-    let field = ChartField::new(mesh, &samples, rounds).ok_or("every triangle is degenerate")?;
+    let mut field = ChartField::new(mesh, &samples, rounds).ok_or("every triangle is degenerate")?;
+    // The shared directions smooth the field across cuts: not for F = S, whose direction is
+    // the UV map's, nor for each triangle's own F.
+    if !matches!(orientation, Orientation::Uv) && smoothing != Smoothing::Triangles {
+        field.share_directions_across_cuts(mesh, &samples);
+    }
     // Overlapping islands: the unmirrored one's field is kept; the renderer mirrors it for the
     // other (DeformationField::at_surface).
     let unmirrored = |t: usize| samples[t].is_some_and(|s| !s.1);
