@@ -4,9 +4,12 @@
 //! interpolated barycentrically inside each triangle. The paper lists these per-vertex values
 //! as the alternative to its UV grid (Eq. 7); on a packed atlas the grid mixes the fields of
 //! neighbouring charts and interpolates between mirrored and unmirrored ones (DESIGN.md section
-//! 5), while the vertices of a chart only ever see that chart. Angles are interpolated as unit
-//! vectors (cos, sin), so that wrapping through +-pi never blends the long way round; the
-//! mirror of a triangle with mirrored UVs is applied per triangle, never interpolated.
+//! 5), while the vertices of a chart only ever see that chart, except that the UV vertices of
+//! one position on a cut may share their direction on the surface
+//! ([`ChartField::share_directions_across_cuts`]; stretches stay per chart). Angles are
+//! interpolated as unit vectors (cos, sin), so that wrapping through +-pi never blends the long
+//! way round; the mirror of a triangle with mirrored UVs is applied per triangle, never
+//! interpolated.
 
 use super::nearest::{NONE, distance2_to_segment, propagate_nearest};
 use crate::geometry::TriangleMesh;
