@@ -9,7 +9,7 @@ use glam::{Mat2, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
-use tessera::deform::analysis::{frame_jumps, seams};
+use tessera::deform::analysis::{frame_jumps, orientation_error, seams};
 use tessera::deform::{DeformationMaps, Orientation, Smoothing, deformation_maps};
 use tessera::geometry::TriangleMesh;
 use tessera::image::{ColorSpace, read_bitmap};
@@ -338,6 +338,8 @@ fn analyze_reports_the_normalised_seams_with_and_without_bands_as_json() {
     assert!(number(&["distortion_classical", "mean_anisotropy"]) > 1.2, "{figures}");
     // The tube is developable and the parallels are its circles: the texture follows them.
     assert!(number(&["orientation_error", "mean"]) < 1.0, "{figures}");
+    // Its u runs along them too, so the classical texture follows them as well.
+    assert!(number(&["orientation_error_classical", "mean"]) < 1.0, "{figures}");
     assert_eq!(number(&["uv_overlap"]), 0.0);
     // The bark exemplar's dark corners and blurred half show the paving's lattice.
     assert!(number(&["lattice_visibility"]) > 1.5, "{figures}");
@@ -402,4 +404,9 @@ fn the_texture_axis_hardly_turns_across_a_cut_between_charts_whose_fields_differ
     eprintln!("frame jumps: across the cuts {cuts:?}, inside the charts {interior:?}");
     assert!(cuts.mean < 0.5 && cuts.p95 < 1.0, "{cuts:?}");
     assert!(interior.mean < 0.5, "{interior:?}");
+    // The classical texture's x axis follows each chart's u, turned by 0.4 and -0.9 radians.
+    let orientation = Orientation::Fixed(Vec3::new(1.0, 1.0, 0.0));
+    let classical = orientation_error(&mesh, &orientation, |_, _| Mat2::IDENTITY).unwrap();
+    let deformed = orientation_error(&mesh, &orientation, |uv, mirrored| field.at_surface(uv, Some(mirrored))).unwrap();
+    assert!(classical.mean > 10.0 && deformed.mean < 1.0, "classical {classical:?}, deformed {deformed:?}");
 }

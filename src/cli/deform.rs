@@ -308,22 +308,23 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
             );
         }
     }
-    if let Some(e) = a.orientation_error {
+    let angles = |e: Option<analysis::AngleError>| {
+        e.map_or("n/a".to_string(), |e| format!("mean {:.2} degrees, 95th percentile {:.2}", e.mean, e.p95))
+    };
+    if a.orientation_error.is_some() {
         println!(
             "orientation error (the texture's x axis J F^-1 e1 against the orientation field, area-weighted): \
-             mean {:.2} degrees, 95th percentile {:.2} degrees",
-            e.mean, e.p95
+             classical {}; deformed {}",
+            angles(a.orientation_error_classical),
+            angles(a.orientation_error)
         );
     }
     if let Some(jumps) = a.frame_jumps {
-        let figure = |e: Option<analysis::AngleError>| {
-            e.map_or("n/a".to_string(), |e| format!("mean {:.2} degrees, 95th percentile {:.2}", e.mean, e.p95))
-        };
         println!(
             "frame jumps (the angle between the texture's x axis on an edge's two faces, unfolded, edge-length \
              weighted): across cuts {}; inside charts {}",
-            figure(jumps.cuts),
-            figure(jumps.interior)
+            angles(jumps.cuts),
+            angles(jumps.interior)
         );
     }
     if let Some(v) = a.lattice_visibility {

@@ -320,6 +320,9 @@ pub struct Analysis {
     pub seam_samples: usize,
     /// Angle between the deformed texture's x axis and the orientation field.
     pub orientation_error: Option<AngleError>,
+    /// The same for the classical texture (F = I), whose x axis follows the UV map's u: what
+    /// the deformation corrects.
+    pub orientation_error_classical: Option<AngleError>,
     /// How far the deformed texture's x axis turns across cuts and across edges inside charts.
     pub frame_jumps: Option<FrameJumps>,
     /// Fold-over of the tiles' lookups through the F map, read at the point (Eq. 3).
@@ -413,6 +416,7 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
         orientation_error: orientation_error(mesh, input.orientation, |uv, mirrored| {
             field.at_surface(uv, Some(mirrored))
         }),
+        orientation_error_classical: orientation_error(mesh, input.orientation, |_, _| Mat2::IDENTITY),
         frame_jumps: frame_jumps(mesh, |uv, mirrored| field.at_surface(uv, Some(mirrored))),
         // A hexagonal tile reaches one lattice spacing from its centre.
         fold_over: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::Point),
