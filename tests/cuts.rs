@@ -340,6 +340,11 @@ fn analyze_reports_the_normalised_seams_with_and_without_bands_as_json() {
     assert!(number(&["orientation_error", "mean"]) < 1.0, "{figures}");
     // Its u runs along them too, so the classical texture follows them as well.
     assert!(number(&["orientation_error_classical", "mean"]) < 1.0, "{figures}");
+    // Unrolled, the tube's UV map is one linear map and its parallels are straight lines, so
+    // nothing bounds a continuous F from below.
+    assert!(number(&["continuity_bound", "orientation", "p95"]) < 0.1, "{figures}");
+    assert!(number(&["continuity_bound", "anisotropy"]) < 1.001, "{figures}");
+    assert!(number(&["continuity_bound", "log_area_jump"]) < 1e-3, "{figures}");
     assert_eq!(number(&["uv_overlap"]), 0.0);
     // The bark exemplar's dark corners and blurred half show the paving's lattice.
     assert!(number(&["lattice_visibility"]) > 1.5, "{figures}");

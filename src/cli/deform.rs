@@ -327,6 +327,17 @@ pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize,
             angles(jumps.interior)
         );
     }
+    if let Some(b) = a.continuity_bound {
+        println!(
+            "what no F continuous in UV can beat, over {} edges inside charts (J_B J_A^-1 across each edge, \
+             edge-length weighted): orientation error on the worse face {}; anisotropy on the worse face mean {:.3}; \
+             ln area jumps by {:.3} (rms)",
+            b.edges,
+            angles(b.orientation),
+            b.anisotropy,
+            b.log_area_jump
+        );
+    }
     if let Some(v) = a.lattice_visibility {
         println!(
             "lattice visibility (power at the paving's lattice frequencies over the exemplar's there, classical \

@@ -17,10 +17,14 @@
 //!   2:1, for tile centres in every direction at a tile's distance (the paper's open "cracks").
 //!   Measured on the F map's texels inside UV triangles.
 //! - **distortion**: [`super::distortion`], classical and deformed.
+//! - **continuity bound**: [`super::continuity_bound`], what no F continuous in UV can beat on
+//!   the mesh's UV map, for the orientation error and the anisotropy.
 
+use super::bound::{ContinuityBound, continuity_bound};
+use super::edges::manifold_edges;
 use super::fold::{DIRECTIONS, LookupFold, centred_fold, lookup_fold};
 use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion};
-use crate::geometry::{Topology, TriangleMesh};
+use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
 use crate::texture::tiling_blending::{
@@ -87,7 +91,7 @@ pub struct AngleError {
 
 impl AngleError {
     /// The statistics of `(angle in degrees, weight)` pairs; None without weight.
-    fn of(mut angles: Vec<(f64, f64)>) -> Option<Self> {
+    pub(super) fn of(mut angles: Vec<(f64, f64)>) -> Option<Self> {
         let total: f64 = angles.iter().map(|a| a.1).sum();
         if !(total > 0.0) {
             return None;
@@ -163,42 +167,16 @@ pub struct FrameJumps {
 /// angle is the jump of the piecewise-linear UV map's Jacobian J between the faces; across a
 /// cut it adds the mismatch of the two charts' fields there. Weighted by edge length.
 pub fn frame_jumps(mesh: &TriangleMesh, f_at: impl Fn(Vec2, bool) -> Mat2) -> Option<FrameJumps> {
-    let uvs = mesh.uvs.as_ref()?;
-    let (welded, points) = mesh.welded_vertices();
-    let triangles: Vec<[u32; 3]> = mesh.indices.iter().map(|t| t.map(|i| welded[i as usize])).collect();
-    let topology = Topology::new(&triangles);
     let (mut cuts, mut interior) = (Vec::new(), Vec::new());
-    for e in 0..topology.edge_count() {
-        let &[h0, h1] = topology.halves(e) else { continue };
-        let [a, b] = topology.edge_vertices(e);
-        // Each face's positions, UVs, and the UVs it gives the edge's endpoints a and b.
-        let face = |h: u32| {
-            let t = mesh.indices[topology.face_of(h as usize)];
-            let x = t.map(|i| mesh.positions[i as usize]);
-            let u = t.map(|i| uvs[i as usize]);
-            let at = |v: u32| (0..3).find(|&k| welded[t[k] as usize] == v).map(|k| u[k]);
-            (x, u, at(a).zip(at(b)))
+    for edge in manifold_edges(mesh)?.iter().filter(|e| !(e.cut && e.singular)) {
+        let axis = |side: usize| {
+            let face = &edge.faces[side];
+            let axis = texture_axis(face.x, face.u, f_at((face.ends[0] + face.ends[1]) / 2.0, uv_mirrored(face.u)))?;
+            Some(edge.flat(side, axis))
         };
-        let ((x0, u0, Some(ends0)), (x1, u1, Some(ends1))) = (face(h0), face(h1)) else { continue };
-        let singular = ends0.0.distance_squared(ends1.0) < 1e-12 || ends0.1.distance_squared(ends1.1) < 1e-12;
-        let cut = ends0.0.distance_squared(ends1.0) > 1e-12 || ends0.1.distance_squared(ends1.1) > 1e-12;
-        if cut && singular {
-            continue;
-        }
-        let axis = |x: [Vec3; 3], u: [Vec2; 3], ends: (Vec2, Vec2)| {
-            texture_axis(x, u, f_at((ends.0 + ends.1) / 2.0, uv_mirrored(u)))
-        };
-        let (Some(axis0), Some(axis1)) = (axis(x0, u0, ends0), axis(x1, u1, ends1)) else { continue };
-        // Unfold: the rotation about the edge taking face 1's normal to face 0's takes
-        // n1 x edge to n0 x edge.
-        let (pa, pb) = (points[a as usize], points[b as usize]);
-        let Some(edge) = (pb - pa).try_normalize() else { continue };
-        let normal = |x: [Vec3; 3]| (x[1] - x[0]).cross(x[2] - x[0]).try_normalize();
-        let (Some(n0), Some(n1)) = (normal(x0), normal(x1)) else { continue };
-        let unfolded = edge * axis1.dot(edge) + n0.cross(edge) * axis1.dot(n1.cross(edge));
-        let angle = axis0.dot(unfolded).clamp(-1.0, 1.0).acos().to_degrees() as f64;
-        let length = pa.distance(pb) as f64;
-        if cut { &mut cuts } else { &mut interior }.push((angle, length));
+        let (Some(axis0), Some(axis1)) = (axis(0), axis(1)) else { continue };
+        let angle = axis0.dot(axis1).clamp(-1.0, 1.0).acos().to_degrees() as f64;
+        if edge.cut { &mut cuts } else { &mut interior }.push((angle, edge.length as f64));
     }
     Some(FrameJumps { cuts: AngleError::of(cuts), interior: AngleError::of(interior) })
 }
@@ -325,6 +303,8 @@ pub struct Analysis {
     pub orientation_error_classical: Option<AngleError>,
     /// How far the deformed texture's x axis turns across cuts and across edges inside charts.
     pub frame_jumps: Option<FrameJumps>,
+    /// What no F continuous in UV can do better than at the edges inside charts.
+    pub continuity_bound: Option<ContinuityBound>,
     /// Fold-over of the tiles' lookups through the F map, read at the point (Eq. 3).
     pub fold_over: FoldOver,
     /// The same, the tiles reading F at their centres ([`FieldAt::TileCentre`]).
@@ -418,6 +398,7 @@ pub fn analyze(input: &AnalysisInput) -> Result<Analysis, String> {
         }),
         orientation_error_classical: orientation_error(mesh, input.orientation, |_, _| Mat2::IDENTITY),
         frame_jumps: frame_jumps(mesh, |uv, mirrored| field.at_surface(uv, Some(mirrored))),
+        continuity_bound: continuity_bound(mesh, input.orientation),
         // A hexagonal tile reaches one lattice spacing from its centre.
         fold_over: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::Point),
         fold_over_at_centres: fold_over(&maps.f_map, &maps.coverage, &charts, input.tile_size, FieldAt::TileCentre),

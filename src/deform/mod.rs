@@ -4,8 +4,10 @@
 //! reads (`deformation = [{ type = "map", ... }]`).
 
 pub mod analysis;
+mod bound;
 mod cuts;
 mod distortion;
+mod edges;
 mod field;
 mod fold;
 mod geodesic;
@@ -14,6 +16,7 @@ mod nearest;
 mod overlap;
 
 pub use analysis::{Analysis, AnalysisInput, analyze};
+pub use bound::{ContinuityBound, continuity_bound};
 pub use cuts::{CutEdge, Cuts, SeamPoint};
 pub use distortion::{Distortion, distortion};
 pub use field::{ChartField, FieldSample, TriangleRaster};
