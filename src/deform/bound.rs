@@ -20,7 +20,7 @@ use super::analysis::AngleError;
 use super::deformation_gradient;
 use super::edges::manifold_edges;
 use crate::geometry::TriangleMesh;
-use glam::{Mat2, Vec2};
+use glam::{DVec2, Mat2, Vec2};
 
 /// Lower bounds on the texture's orientation error and distortion at the edges inside charts,
 /// for any F continuous in UV, edge-length weighted.
@@ -76,25 +76,30 @@ pub fn continuity_bound(mesh: &TriangleMesh, orientation: &Orientation) -> Optio
     })
 }
 
-/// min over unit a of max(angle(a, `oa`), angle(`jump` a, `ob`)), in degrees: the direction is
-/// searched on a grid of half a degree, then refined twice around the best.
+/// min over unit a of max(angle(a, `oa`), angle(`jump` a, `ob`)), in degrees: the best of a
+/// grid of 10-degree steps, then a golden-section search within a step of it.
 fn least_larger_angle(jump: Mat2, oa: Vec2, ob: Vec2) -> f64 {
-    let angle = |p: Vec2, q: Vec2| p.angle_to(q).abs() as f64;
+    use std::f64::consts::{PI, TAU};
+    let jump = jump.as_dmat2();
+    let (to_a, to_b) = (f64::from(oa.y).atan2(f64::from(oa.x)), f64::from(ob.y).atan2(f64::from(ob.x)));
+    let apart = |p: f64, q: f64| (p - q + PI).rem_euclid(TAU) - PI;
     let larger = |phi: f64| {
-        let a = Vec2::from_angle(phi as f32);
-        angle(a, oa).max(angle(jump * a, ob))
+        let turned = jump * DVec2::from_angle(phi);
+        apart(phi, to_a).abs().max(apart(turned.y.atan2(turned.x), to_b).abs())
     };
-    let (mut best, mut step) = (0.0, std::f64::consts::TAU / 720.0);
-    for (steps, around) in [(720, false), (40, true), (40, true)] {
-        let start = if around { best - step } else { 0.0 };
-        let grid_step = if around { 2.0 * step / steps as f64 } else { step };
-        best = (0..=steps)
-            .map(|k| start + k as f64 * grid_step)
-            .min_by(|p, q| larger(*p).total_cmp(&larger(*q)))
-            .expect("a non-empty grid");
-        step = grid_step;
+    let step = TAU / 36.0;
+    let best = (0..36).map(|k| k as f64 * step).min_by(|p, q| larger(*p).total_cmp(&larger(*q))).expect("36 points");
+    let (mut low, mut high) = (best - step, best + step);
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    for _ in 0..48 {
+        let (p, q) = (high - ratio * (high - low), low + ratio * (high - low));
+        if larger(p) < larger(q) {
+            high = q;
+        } else {
+            low = p;
+        }
     }
-    larger(best).to_degrees()
+    larger((low + high) / 2.0).to_degrees()
 }
 
 /// Singular values sigma_1 >= sigma_2 of a 2x2 matrix, in f64.
