@@ -437,3 +437,81 @@ fn deform_warns_about_cuts_that_no_band_closes() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.contains("8 cut edges are UV singularities"), "{stderr}");
 }
+
+#[test]
+fn packing_overlapping_charts_apart_gives_each_island_its_own_field() {
+    // The cube sphere's -x face shares the +x face's UV square, mirrored. Parallels about z are
+    // antisymmetric under that mirror, so the shared field turns the -x face's texture by 180
+    // degrees. Packed apart, each face has its own field and follows the parallels.
+    use tessera::deform::analysis::orientation_error;
+    use tessera::deform::{pack_charts, uv_charts};
+    use tessera::texture::MipMap;
+    use tessera::texture::tiling_blending::{Deformation, DeformationField};
+    let orientation = Orientation::Parallels(Vec3::Z);
+    let measure = |mesh: &TriangleMesh| {
+        let maps = deformation_maps(mesh, &orientation, Smoothing::Vertices(1), 256, 0.05).unwrap();
+        let field = DeformationField::new(vec![Deformation::Map(MipMap::new(maps.f_map.clone()))]);
+        let error = orientation_error(mesh, &orientation, |uv, mirrored| field.at_surface(uv, Some(mirrored))).unwrap();
+        (error.mean, maps.overlap().fraction())
+    };
+    let stacked = cube_sphere(8, true);
+    let (charts, count) = uv_charts(&stacked).unwrap();
+    assert_eq!(count, 6);
+    let packed = pack_charts(&stacked, &charts, 0.01).unwrap();
+    let (before, overlap_before) = measure(&stacked);
+    let (after, overlap_after) = measure(&packed.mesh);
+    let (apart, _) = measure(&cube_sphere(8, false));
+    eprintln!(
+        "orientation error: stacked {before}, packed {after}, laid apart by hand {apart}; scale {}",
+        packed.scale
+    );
+    assert!(overlap_before > 0.1 && overlap_after == 0.0, "{overlap_before} {overlap_after}");
+    assert!(before > 20.0, "{before}");
+    // (What is left is the parallels' singular points, on the +-z faces.)
+    assert!(after < 3.0 && (after - apart).abs() < 0.1, "{after} against {apart}");
+    // Only the UVs change, each chart's by one translation and the common scale: every UV edge
+    // is the old one times the scale, orientation (mirrored or not) kept.
+    assert_eq!((&packed.mesh.positions, &packed.mesh.indices), (&stacked.positions, &stacked.indices));
+    let (old, new) = (stacked.uvs.as_ref().unwrap(), packed.mesh.uvs.as_ref().unwrap());
+    for t in &stacked.indices {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let expected = (old[b] - old[a]) * packed.scale;
+            assert!((new[b] - new[a] - expected).length() < 1e-5, "{} against {expected}", new[b] - new[a]);
+        }
+    }
+    assert!(new.iter().all(|uv| uv.cmpge(Vec2::splat(0.01 - 1e-6)).all() && uv.cmple(Vec2::splat(0.99 + 1e-6)).all()));
+    // Charts that cannot fit at any scale: an error, not a panic.
+    // (At 0.3 apart, two margins and two boxes of no size fill a row, two rows the square.)
+    assert!(pack_charts(&stacked, &charts, 0.3).is_err());
+}
+
+#[test]
+fn deform_repack_writes_the_mesh_it_packed_beside_the_maps() {
+    let dir = tempfile::tempdir().unwrap();
+    let stacked = cube_sphere(4, true);
+    std::fs::write(dir.path().join("stacked.obj"), common::obj_text(&stacked)).unwrap();
+    let deform = |mesh: &std::path::Path, out: &std::path::Path, repack: bool| {
+        let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_tessera"));
+        command.arg("deform").arg(mesh).args(["--res", "64", "--orientation", "parallels:0,0,1", "-o"]).arg(out);
+        if repack {
+            command.arg("--repack");
+        }
+        let run = command.output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        String::from_utf8_lossy(&run.stderr).into_owned()
+    };
+    let warned = deform(&dir.path().join("stacked.obj"), &dir.path().join("plain"), false);
+    assert!(warned.contains("overlapping UV islands") && warned.contains("--repack"), "{warned}");
+    assert!(!dir.path().join("plain/mesh.obj").exists());
+    let told = deform(&dir.path().join("stacked.obj"), &dir.path().join("packed"), true);
+    assert!(told.contains("mesh.obj"), "{told}");
+    // The written mesh reads back with the same positions and triangles, and overlaps nowhere.
+    let written = tessera::geometry::obj::load_obj(&dir.path().join("packed/mesh.obj")).unwrap();
+    assert_eq!(written.indices.len(), stacked.indices.len());
+    let corners =
+        |m: &TriangleMesh| -> Vec<Vec3> { m.indices.iter().flatten().map(|&i| m.positions[i as usize]).collect() };
+    assert!(corners(&written).iter().zip(corners(&stacked)).all(|(a, b)| a.distance(b) < 1e-6));
+    let again = deform(&dir.path().join("packed/mesh.obj"), &dir.path().join("again"), false);
+    assert!(!again.contains("overlapping"), "{again}");
+}

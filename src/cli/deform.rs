@@ -9,10 +9,12 @@ use std::sync::Arc;
 use std::time::Instant;
 use tessera::deform::{
     AnalysisInput, DeformationMaps, Distortion, Orientation, Smoothing, analysis, deformation_maps, distortion,
+    pack_charts, uv_charts,
 };
 use tessera::error::{Error, Result};
 use tessera::files::StagedFolder;
 use tessera::geometry::TriangleMesh;
+use tessera::geometry::obj::obj_text;
 use tessera::image::{ColorSpace, read_bitmap, write_exr, write_image};
 use tessera::limits;
 use tessera::texture::tiling_blending::{Deformation, DeformationField, FieldAt, cuts_to_json};
@@ -43,17 +45,44 @@ pub struct MeshArgs {
     /// cut bands pictured and analysed (the renderer lays them for the scene's own).
     #[arg(long, default_value_t = 0.25)]
     tile_size: f32,
+    /// Pack the mesh's UV charts apart first (each moved and scaled by one common factor), so
+    /// that overlapping islands get a field each; `deform` writes the mesh it made as mesh.obj
+    /// beside the maps, the mesh to render with them.
+    #[arg(long)]
+    repack: bool,
+}
+
+/// What [`MeshArgs::maps`] derives.
+struct Derived {
+    /// The mesh the maps are for: the file's, or with its charts packed apart (`--repack`).
+    mesh: TriangleMesh,
+    /// The factor `--repack` scaled every chart's UVs by.
+    repacked_scale: Option<f32>,
+    maps: DeformationMaps,
+    orientation: Orientation,
+    /// Seconds spent loading and deriving.
+    times: [f64; 2],
 }
 
 impl MeshArgs {
     /// Load the mesh and derive its maps, with the orientation field they follow; also says how
     /// long each took.
-    fn maps(&self) -> Result<(TriangleMesh, DeformationMaps, Orientation, [f64; 2])> {
+    fn maps(&self) -> Result<Derived> {
         if !(self.tile_size > 1e-6 && self.tile_size <= 1e4) {
             return Err(Error::param("--tile-size", format!("{} is not in (1e-6, 1e4] UV units", self.tile_size)));
         }
         let start = Instant::now();
-        let (mesh, tangents) = tessera::scene::load_surface(&self.mesh)?;
+        let (mut mesh, tangents) = tessera::scene::load_surface(&self.mesh)?;
+        let mut repacked_scale = None;
+        if self.repack {
+            let (charts, _) = uv_charts(&mesh)
+                .ok_or_else(|| Error::mesh(&self.mesh, "--repack: the mesh has no texture coordinates"))?;
+            // Four texels of the maps apart: a bilinear lookup at a chart's border reads its own
+            // chart's texels (a gutter's texels take the nearest chart's field).
+            let repacked =
+                pack_charts(&mesh, &charts, 4.0 / self.res as f32).map_err(|msg| Error::mesh(&self.mesh, msg))?;
+            (mesh, repacked_scale) = (repacked.mesh, Some(repacked.scale));
+        }
         let loaded = start.elapsed().as_secs_f64();
         let orientation = match (self.orientation.as_str(), tangents) {
             ("tangents", Some(tangents)) => Orientation::PerVertex(tangents),
@@ -90,7 +119,7 @@ impl MeshArgs {
                 "warning: {}: {:.2}% of the UV area is covered by more than one triangle (overlapping UV islands): \
                  the F map holds one deformation per texel, the unmirrored island's; a mirrored island on it reads it \
                  mirrored (exact for mirror-image halves under a mirror-symmetric orientation field), any other \
-                 shares it as it is",
+                 shares it as it is; --repack packs the charts apart, each with its own field",
                 self.mesh.display(),
                 100.0 * overlap.fraction()
             );
@@ -112,7 +141,8 @@ impl MeshArgs {
                 maps.cuts.edges.len() - banded
             );
         }
-        Ok((mesh, maps, orientation, [loaded, start.elapsed().as_secs_f64() - loaded]))
+        let times = [loaded, start.elapsed().as_secs_f64() - loaded];
+        Ok(Derived { mesh, repacked_scale, maps, orientation, times })
     }
 }
 
@@ -179,7 +209,7 @@ fn print_distortion(classical: Option<Distortion>, deformed: Option<Distortion>)
 
 /// `tessera deform`.
 pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
-    let (mesh, maps, _, [loaded, computed]) = args.maps()?;
+    let Derived { mesh, repacked_scale, maps, times: [loaded, computed], .. } = args.maps()?;
     // (`analyze` prints the fold-over among its figures.)
     let charts = maps.chart_of_texels();
     let fold = analysis::fold_over(&maps.f_map, &maps.coverage, &charts, args.tile_size, FieldAt::Point);
@@ -219,6 +249,11 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
     write_image(&staged.path().join("det_f.png"), &det, &[])?;
     write_image(&staged.path().join("orientation.png"), &orientation_picture, &[])?;
     write_image(&staged.path().join("cut_bands.png"), &tessera::deform::bands_picture(&maps.bands, &maps.f_map), &[])?;
+    if repacked_scale.is_some() {
+        let comment = format!("{} with its UV charts packed apart by tessera deform --repack", args.mesh.display());
+        let obj = staged.path().join("mesh.obj");
+        std::fs::write(&obj, obj_text(&mesh, &comment)).map_err(|e| Error::io(&obj, e))?;
+    }
     staged.commit()?;
     let field = f_map_field(&maps);
     print_distortion(distortion(&mesh, |_| Mat2::IDENTITY), distortion(&mesh, |uv| field.at(uv)));
@@ -227,7 +262,7 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         "{}: {} triangles ({} mirrored in UV) in {}, smoothing {} ({} texels outside every triangle, \
          extrapolated from the nearest), \
          {} in {} (bands for tile size {}), maps {res}x{res}; load {loaded:.2} s, deform {computed:.2} s; \
-         wrote f_map.exr, charts.exr, cuts.json, det_f.png, orientation.png, cut_bands.png to {}",
+         wrote f_map.exr, charts.exr, cuts.json, det_f.png, orientation.png, cut_bands.png{} to {}",
         args.mesh.display(),
         mesh.indices.len(),
         maps.mirrored,
@@ -240,8 +275,17 @@ pub fn deform(args: &MeshArgs, output: &Path) -> Result<ExitCode> {
         counted(maps.cuts.edges.len(), "cut edge"),
         counted(maps.cuts.chains.len(), "cut"),
         args.tile_size,
+        if repacked_scale.is_some() { ", mesh.obj" } else { "" },
         output.display(),
     );
+    if let Some(scale) = repacked_scale {
+        eprintln!(
+            "packed the {} apart at {scale:.4} times their UV size and wrote that mesh as mesh.obj: render it with \
+             these maps (the texture keeps its size on the surface; a tile_size in UV units spans 1/{scale:.4} times \
+             the length on the surface it spanned on the original UVs: multiply it by {scale:.4} to keep the tiles)",
+            counted(maps.field.charts, "chart")
+        );
+    }
     Ok(ExitCode::SUCCESS)
 }
 
@@ -252,7 +296,10 @@ fn counted(n: usize, noun: &str) -> String {
 
 /// `tessera analyze`: the figures of [`tessera::deform::analysis`], as text or JSON.
 pub fn analyze(args: &MeshArgs, exemplar_path: &Path, seed: u64, samples: usize, json: bool) -> Result<ExitCode> {
-    let (mesh, maps, orientation, _) = args.maps()?;
+    let Derived { mesh, repacked_scale, maps, orientation, .. } = args.maps()?;
+    if let Some(scale) = repacked_scale {
+        eprintln!("note: the mesh's UV charts packed apart at {scale:.4} times their size (--repack)");
+    }
     let bitmap = read_bitmap(exemplar_path, ColorSpace::Srgb)?;
     let exemplar = Arc::new(Texture::Image(ImageTexture {
         mipmap: Arc::new(MipMap::new(bitmap)),

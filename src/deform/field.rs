@@ -63,20 +63,7 @@ impl ChartField {
     pub fn new(mesh: &TriangleMesh, samples: &[TriangleSample], smoothing: usize) -> Option<Self> {
         let uvs = mesh.uvs.as_ref()?;
         let fallback = samples.iter().flatten().next()?.0;
-        let (welded, _) = mesh.welded_vertices();
-        let mut ids: HashMap<(u32, [u32; 2]), u32> = HashMap::new();
-        let corners: Vec<[u32; 3]> = mesh
-            .indices
-            .iter()
-            .map(|idx| {
-                idx.map(|i| {
-                    let key = (welded[i as usize], uvs[i as usize].to_array().map(f32::to_bits));
-                    let next = ids.len() as u32;
-                    *ids.entry(key).or_insert(next)
-                })
-            })
-            .collect();
-        let vertices = ids.len();
+        let (corners, vertices) = uv_vertices(mesh, uvs);
         let (chart_of_triangle, charts) = charts(&corners, vertices);
         let areas: Vec<f32> = mesh
             .indices
@@ -240,6 +227,33 @@ impl ChartField {
 /// [`ChartField::share_directions_across_cuts`] leaves a position alone where its sides'
 /// texture axes differ by more than this angle's cosine (30 degrees).
 const AGREEING_AXES_COS: f32 = 0.866_025_4;
+
+/// The UV vertex (a welded position with one UV) at each corner of each triangle of `mesh`,
+/// whose UVs are `uvs`, numbered from 0; and how many there are.
+fn uv_vertices(mesh: &TriangleMesh, uvs: &[Vec2]) -> (Vec<[u32; 3]>, usize) {
+    let (welded, _) = mesh.welded_vertices();
+    let mut ids: HashMap<(u32, [u32; 2]), u32> = HashMap::new();
+    let corners = mesh
+        .indices
+        .iter()
+        .map(|idx| {
+            idx.map(|i| {
+                let key = (welded[i as usize], uvs[i as usize].to_array().map(f32::to_bits));
+                let next = ids.len() as u32;
+                *ids.entry(key).or_insert(next)
+            })
+        })
+        .collect();
+    (corners, ids.len())
+}
+
+/// The UV chart (island: triangles joined through shared UV vertices) of each triangle of
+/// `mesh`, numbered from 0 in the order of their first triangles, as [`ChartField`] finds them;
+/// and how many there are. None without UVs.
+pub fn uv_charts(mesh: &TriangleMesh) -> Option<(Vec<u32>, usize)> {
+    let (corners, vertices) = uv_vertices(mesh, mesh.uvs.as_ref()?);
+    Some(charts(&corners, vertices))
+}
 
 /// The connected components of triangles sharing a vertex: the chart of each triangle (numbered
 /// from 0 in order of first appearance) and their number.

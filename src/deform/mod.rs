@@ -14,15 +14,17 @@ mod geodesic;
 mod gradient;
 mod nearest;
 mod overlap;
+mod repack;
 
 pub use analysis::{Analysis, AnalysisInput, analyze};
 pub use bound::{ContinuityBound, continuity_bound};
 pub use cuts::{CutEdge, Cuts, SeamPoint};
 pub use distortion::{Distortion, distortion};
-pub use field::{ChartField, FieldSample, TriangleRaster};
+pub use field::{ChartField, FieldSample, TriangleRaster, uv_charts};
 
 pub use gradient::{TriangleDeformation, deformation_gradient};
 pub use overlap::{UvOverlap, uv_area_outside_square, uv_coverage, uv_overlap};
+pub use repack::{Repacked, pack_charts};
 
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;

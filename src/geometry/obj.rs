@@ -1,5 +1,5 @@
-//! Wavefront OBJ loading (tobj): polygons triangulated, one index per vertex, `vt` kept as is
-//! (OBJ's bottom-left origin is tessera's convention).
+//! Wavefront OBJ files: loading (tobj; polygons triangulated, one index per vertex, `vt` kept as is
+//! (OBJ's bottom-left origin is tessera's convention)) and writing.
 
 use super::TriangleMesh;
 use crate::error::{Error, Result, guard_parser};
@@ -58,4 +58,35 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh> {
     let mesh =
         TriangleMesh { positions, normals: has_normals.then_some(normals), uvs: has_uvs.then_some(uvs), indices };
     Ok(mesh)
+}
+
+/// `mesh` as OBJ text after a `comment` line: `v`, then `vt` and `vn` where the mesh has them,
+/// one per vertex, and one `f` per triangle (1-based, the same index for all three), which
+/// [`load_obj`] reads back to the same mesh.
+pub fn obj_text(mesh: &TriangleMesh, comment: &str) -> String {
+    use std::fmt::Write;
+    let mut obj = String::with_capacity(mesh.positions.len() * 60 + mesh.indices.len() * 30);
+    let _ = writeln!(obj, "# {comment}");
+    for p in &mesh.positions {
+        let _ = writeln!(obj, "v {} {} {}", p.x, p.y, p.z);
+    }
+    for t in mesh.uvs.iter().flatten() {
+        let _ = writeln!(obj, "vt {} {}", t.x, t.y);
+    }
+    for n in mesh.normals.iter().flatten() {
+        let _ = writeln!(obj, "vn {} {} {}", n.x, n.y, n.z);
+    }
+    let corner = |i: u32| {
+        let i = i + 1;
+        match (mesh.uvs.is_some(), mesh.normals.is_some()) {
+            (true, true) => format!("{i}/{i}/{i}"),
+            (true, false) => format!("{i}/{i}"),
+            (false, true) => format!("{i}//{i}"),
+            (false, false) => format!("{i}"),
+        }
+    };
+    for t in &mesh.indices {
+        let _ = writeln!(obj, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]));
+    }
+    obj
 }

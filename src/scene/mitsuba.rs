@@ -30,7 +30,8 @@ use crate::camera::{FovAxis, Projection};
 use crate::color::Rgb;
 use crate::error::{Error, Result};
 use crate::files::StagedFolder;
-use crate::geometry::{Frame, Sphere};
+use crate::geometry::obj::obj_text;
+use crate::geometry::{Frame, Sphere, TriangleMesh};
 use crate::image::{PixelFilter, write_exr};
 use crate::light::{Environment, SpotFalloff};
 use crate::limits;
@@ -385,30 +386,17 @@ impl Exporter<'_> {
         let shape = &g.shapes[index];
         let first = shape.first_vertex as usize;
         let end = g.shapes.get(index + 1).map_or(g.positions.len(), |s| s.first_vertex as usize);
-        let mut obj = format!("# shape {index} of {}, exported by tessera (world space)\n", self.scene.path.display());
-        for p in &g.positions[first..end] {
-            let _ = writeln!(obj, "v {} {} {}", p.x, p.y, p.z);
-        }
-        if shape.has_uvs {
-            for t in &g.uvs[first..end] {
-                let _ = writeln!(obj, "vt {} {}", t.x, t.y);
-            }
-        }
-        if shape.has_normals {
-            for n in &g.normals[first..end] {
-                let _ = writeln!(obj, "vn {} {} {}", n.x, n.y, n.z);
-            }
-        }
-        for (tri, _) in g.triangles.iter().zip(&g.triangle_shape).filter(|(_, s)| **s as usize == index) {
-            let v = tri.map(|i| i as usize - first + 1);
-            let corner = |i: usize| match (shape.has_uvs, shape.has_normals) {
-                (true, true) => format!("{i}/{i}/{i}"),
-                (true, false) => format!("{i}/{i}"),
-                (false, true) => format!("{i}//{i}"),
-                (false, false) => format!("{i}"),
-            };
-            let _ = writeln!(obj, "f {} {} {}", corner(v[0]), corner(v[1]), corner(v[2]));
-        }
+        let mesh = TriangleMesh {
+            positions: g.positions[first..end].to_vec(),
+            normals: shape.has_normals.then(|| g.normals[first..end].to_vec()),
+            uvs: shape.has_uvs.then(|| g.uvs[first..end].to_vec()),
+            indices: (g.triangles.iter().zip(&g.triangle_shape))
+                .filter(|(_, s)| **s as usize == index)
+                .map(|(tri, _)| tri.map(|i| i - first as u32))
+                .collect(),
+        };
+        let comment = format!("shape {index} of {}, exported by tessera (world space)", self.scene.path.display());
+        let obj = obj_text(&mesh, &comment);
         let file = format!("meshes/shape{index}.obj");
         self.write_text(&file, &obj)?;
         Ok(file)
