@@ -23,7 +23,8 @@
 use super::bound::{ContinuityBound, continuity_bound};
 use super::edges::manifold_edges;
 use super::fold::{DIRECTIONS, LookupFold, centred_fold, lookup_fold};
-use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, distortion};
+use super::gradient::texture_axis;
+use super::{Cuts, DeformationMaps, Distortion, Orientation, SeamPoint, deformation_gradient, distortion};
 use crate::geometry::TriangleMesh;
 use crate::image::Bitmap;
 use crate::limits;
@@ -110,17 +111,6 @@ impl AngleError {
     }
 }
 
-/// The texture's x axis on the surface, J F^-1 e1 (DESIGN.md section 3), unit length, for the
-/// triangle with positions `x` and UVs `u` and F = `f`; None where either is degenerate.
-fn texture_axis(x: [Vec3; 3], u: [Vec2; 3], f: Mat2) -> Option<Vec3> {
-    let j = super::deformation_gradient(x, u)?;
-    if !(f.determinant().abs() > 1e-12) {
-        return None;
-    }
-    let axis_uv = f.inverse() * Vec2::X;
-    (j.x_axis * axis_uv.x + j.y_axis * axis_uv.y).try_normalize()
-}
-
 /// Whether a triangle's UVs are mirrored (clockwise).
 fn uv_mirrored(u: [Vec2; 3]) -> bool {
     (u[1] - u[0]).perp_dot(u[2] - u[0]) < 0.0
@@ -141,7 +131,11 @@ pub fn orientation_error(
         let Some(o) = direction else { continue };
         let x = idx.map(|i| mesh.positions[i as usize]);
         let u = idx.map(|i| uvs[i as usize]);
-        let Some(axis) = texture_axis(x, u, f_at((u[0] + u[1] + u[2]) / 3.0, uv_mirrored(u))) else { continue };
+        let Some(axis) =
+            deformation_gradient(x, u).and_then(|j| texture_axis(j, f_at((u[0] + u[1] + u[2]) / 3.0, uv_mirrored(u))))
+        else {
+            continue;
+        };
         let normal = (x[1] - x[0]).cross(x[2] - x[0]);
         let Some(along) = (o - normal * o.dot(normal) / normal.length_squared()).try_normalize() else { continue };
         let angle = axis.dot(along).clamp(-1.0, 1.0).acos().to_degrees() as f64;
@@ -171,7 +165,8 @@ pub fn frame_jumps(mesh: &TriangleMesh, f_at: impl Fn(Vec2, bool) -> Mat2) -> Op
     for edge in manifold_edges(mesh)?.iter().filter(|e| !(e.cut && e.singular)) {
         let axis = |side: usize| {
             let face = &edge.faces[side];
-            let axis = texture_axis(face.x, face.u, f_at((face.ends[0] + face.ends[1]) / 2.0, uv_mirrored(face.u)))?;
+            let f = f_at((face.ends[0] + face.ends[1]) / 2.0, uv_mirrored(face.u));
+            let axis = texture_axis(deformation_gradient(face.x, face.u)?, f)?;
             Some(edge.flat(side, axis))
         };
         let (Some(axis0), Some(axis1)) = (axis(0), axis(1)) else { continue };

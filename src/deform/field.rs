@@ -168,12 +168,7 @@ impl ChartField {
         let axis_sum = |v: u32| -> Vec3 {
             let s = self.vertex_samples[v as usize];
             triangles_of[v as usize].iter().fold(Vec3::ZERO, |sum, &(area, j, _, mirrored)| {
-                let f = s.deformation(mirrored);
-                if !(f.determinant().abs() > 1e-20) {
-                    return sum;
-                }
-                let a = f.inverse() * Vec2::X;
-                sum + (j.x_axis * a.x + j.y_axis * a.y).normalize_or_zero() * area
+                sum + super::gradient::texture_axis(j, s.deformation(mirrored)).unwrap_or(Vec3::ZERO) * area
             })
         };
         let mut shared: Vec<(u32, Vec3)> = Vec::new();

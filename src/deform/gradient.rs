@@ -27,6 +27,17 @@ pub fn deformation_gradient(x: [Vec3; 3], u: [Vec2; 3]) -> Option<Mat3> {
     Some(geometric * parametric.inverse())
 }
 
+/// The texture's x axis on the surface, J F^-1 e1 (DESIGN.md section 3), unit length, for a
+/// triangle whose deformation gradient is `j` ([`deformation_gradient`]) and F = `f`; None where
+/// F is singular or the axis degenerate.
+pub fn texture_axis(j: Mat3, f: Mat2) -> Option<Vec3> {
+    if !(f.determinant().abs() > 1e-12) {
+        return None;
+    }
+    let axis_uv = f.inverse() * Vec2::X;
+    (j.x_axis * axis_uv.x + j.y_axis * axis_uv.y).try_normalize()
+}
+
 /// What the texture synthesis needs of one triangle: F3 = R S (Eq. 5) reduced to the UV plane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleDeformation {
