@@ -15,8 +15,8 @@
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
 //! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches.
 
-use super::Hit;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
+use super::{Hit, TraversalStack};
 use crate::geometry::Ray;
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
@@ -272,10 +272,10 @@ impl Bvh4 {
     }
 
     /// The closest hit with `0 < t < ray.t_max`.
-    pub(super) fn intersect(&self, ray: &Ray) -> Option<Hit> {
+    pub(super) fn intersect(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<Hit> {
         let shear = RayShear::new(ray);
         let mut closest: Option<Hit> = None;
-        self.traverse::<true>(&RayBoxes::new(ray), ray.t_max, |leaf, t_max| {
+        self.traverse::<true>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
             for p in leaf.packets() {
                 if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&self.packets[p], *t_max) {
                     closest = Some(Hit { primitive: self.packet_triangles[p][lane], t, b1, b2 });
@@ -288,10 +288,10 @@ impl Bvh4 {
     }
 
     /// Whether anything lies on the ray with `0 < t < ray.t_max`.
-    pub(super) fn occluded(&self, ray: &Ray) -> bool {
+    pub(super) fn occluded(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
         let shear = RayShear::new(ray);
         let mut blocked = false;
-        self.traverse::<false>(&RayBoxes::new(ray), ray.t_max, |leaf, t_max| {
+        self.traverse::<false>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
             blocked = leaf.packets().any(|p| shear.occludes(&self.packets[p], *t_max));
             blocked
         });
@@ -300,13 +300,13 @@ impl Bvh4 {
 
     /// The closest hit of each ray of `rays` (at most 32), as [`Bvh4::intersect`] gives it but
     /// for ties in distance; coherent rays are traced as packets.
-    pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+    pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], stack: &mut TraversalStack) {
         for group in coherent_groups(rays) {
             if group.count_ones() == 1 {
                 let i = group.trailing_zeros() as usize;
-                hits[i] = self.intersect(&rays[i]);
+                hits[i] = self.intersect(&rays[i], stack);
             } else {
-                self.intersect_coherent(rays, group, hits);
+                self.intersect_coherent(rays, group, hits, stack);
             }
         }
     }
@@ -314,7 +314,7 @@ impl Bvh4 {
     /// The closest hits of the rays of `group` (a bit mask into `rays`, at most `PACKET_SIZE`
     /// set; directions in one octant), traversing once for all. Each ray meets the triangles of
     /// the leaves it enters with the same test as alone.
-    fn intersect_coherent(&self, rays: &[Ray], group: u32, hits: &mut [Option<Hit>]) {
+    fn intersect_coherent(&self, rays: &[Ray], group: u32, hits: &mut [Option<Hit>], stack: &mut TraversalStack) {
         // Unused slots repeat the first ray.
         let mut index = [group.trailing_zeros() as usize; PACKET_SIZE];
         let n = group.count_ones() as usize;
@@ -327,7 +327,7 @@ impl Bvh4 {
             hits[i] = None;
         }
         let farthest = |t: &[f32]| t.iter().fold(0.0f32, |a, &b| a.max(b));
-        self.traverse::<true>(&PacketBoxes::new(&packet[..n]), farthest(&t_max[..n]), |leaf, packet_t_max| {
+        self.traverse::<true>(&PacketBoxes::new(&packet[..n]), farthest(&t_max[..n]), stack, |leaf, packet_t_max| {
             for (k, ray) in packet[..n].iter().enumerate() {
                 if !ray.enters(leaf, t_max[k]) {
                     continue;
@@ -347,85 +347,84 @@ impl Bvh4 {
     /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(leaf, t_max)`, which may
     /// shorten `t_max` to a hit and returns true to end the traversal. With `CLOSEST`, children
     /// are visited nearest first and boxes beyond `t_max` are skipped; without, in any order (a
-    /// shadow ray needs any hit, not the nearest).
+    /// shadow ray needs any hit, not the nearest). `stack` holds the children still to visit.
     #[inline(always)]
     fn traverse<const CLOSEST: bool>(
         &self,
         boxes: &impl BoxTest,
         mut t_max: f32,
+        stack: &mut TraversalStack,
         mut leaf: impl FnMut(&Leaf, &mut f32) -> bool,
     ) {
-        TRAVERSAL_STACK.with_borrow_mut(|stack| {
-            stack.clear();
-            let mut current = 0u32;
-            loop {
-                if current & LEAF == 0 {
-                    let node = &self.nodes[current as usize];
-                    let (mut mask, t_near) = boxes.test(node, t_max);
-                    if mask != 0 {
-                        let t_near = t_near.to_array();
-                        if mask & (mask - 1) == 0 {
-                            current = node.children[mask.trailing_zeros() as usize];
-                            continue;
-                        }
-                        let mut rest = mask & (mask - 1);
-                        if !CLOSEST {
-                            // Any order: visit the first, push the others.
-                            current = node.children[mask.trailing_zeros() as usize];
-                            while rest != 0 {
-                                let i = rest.trailing_zeros() as usize;
-                                rest &= rest - 1;
-                                stack.push((node.children[i], 0.0));
-                            }
-                            continue;
-                        }
-                        if rest & (rest - 1) == 0 {
-                            // Two: visit the nearer, push the other (the order the sort below
-                            // would give, ties included).
-                            let (i, j) = (mask.trailing_zeros() as usize, rest.trailing_zeros() as usize);
-                            let (near, far) = if t_near[i] < t_near[j] { (i, j) } else { (j, i) };
-                            stack.push((node.children[far], t_near[far]));
-                            current = node.children[near];
-                            continue;
-                        }
-                        // Three or four: push all but the nearest, farthest first.
-                        let mut hits = [(0u32, 0.0f32); 4];
-                        let mut n = 0;
-                        while mask != 0 {
-                            let i = mask.trailing_zeros() as usize;
-                            mask &= mask - 1;
-                            hits[n] = (node.children[i], t_near[i]);
-                            n += 1;
-                        }
-                        // Insertion sort, farthest first; stable, so that ties keep child order.
-                        for i in 1..n {
-                            let mut j = i;
-                            while j > 0 && hits[j - 1].1 < hits[j].1 {
-                                hits.swap(j - 1, j);
-                                j -= 1;
-                            }
-                        }
-                        stack.extend_from_slice(&hits[..n - 1]);
-                        current = hits[n - 1].0;
+        stack.clear();
+        let mut current = 0u32;
+        loop {
+            if current & LEAF == 0 {
+                let node = &self.nodes[current as usize];
+                let (mut mask, t_near) = boxes.test(node, t_max);
+                if mask != 0 {
+                    let t_near = t_near.to_array();
+                    if mask & (mask - 1) == 0 {
+                        current = node.children[mask.trailing_zeros() as usize];
                         continue;
                     }
-                } else {
-                    if leaf(&self.leaves[(current & !LEAF) as usize], &mut t_max) {
-                        return;
+                    let mut rest = mask & (mask - 1);
+                    if !CLOSEST {
+                        // Any order: visit the first, push the others.
+                        current = node.children[mask.trailing_zeros() as usize];
+                        while rest != 0 {
+                            let i = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            stack.push((node.children[i], 0.0));
+                        }
+                        continue;
                     }
+                    if rest & (rest - 1) == 0 {
+                        // Two: visit the nearer, push the other (the order the sort below
+                        // would give, ties included).
+                        let (i, j) = (mask.trailing_zeros() as usize, rest.trailing_zeros() as usize);
+                        let (near, far) = if t_near[i] < t_near[j] { (i, j) } else { (j, i) };
+                        stack.push((node.children[far], t_near[far]));
+                        current = node.children[near];
+                        continue;
+                    }
+                    // Three or four: push all but the nearest, farthest first.
+                    let mut hits = [(0u32, 0.0f32); 4];
+                    let mut n = 0;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        hits[n] = (node.children[i], t_near[i]);
+                        n += 1;
+                    }
+                    // Insertion sort, farthest first; stable, so that ties keep child order.
+                    for i in 1..n {
+                        let mut j = i;
+                        while j > 0 && hits[j - 1].1 < hits[j].1 {
+                            hits.swap(j - 1, j);
+                            j -= 1;
+                        }
+                    }
+                    stack.extend_from_slice(&hits[..n - 1]);
+                    current = hits[n - 1].0;
+                    continue;
                 }
-                // Next: the nearest entry on the stack that is not beyond the closest hit.
-                loop {
-                    let Some((next, t_near)) = stack.pop() else {
-                        return;
-                    };
-                    if !CLOSEST || t_near <= t_max {
-                        current = next;
-                        break;
-                    }
+            } else {
+                if leaf(&self.leaves[(current & !LEAF) as usize], &mut t_max) {
+                    return;
                 }
             }
-        })
+            // Next: the nearest entry on the stack that is not beyond the closest hit.
+            loop {
+                let Some((next, t_near)) = stack.pop() else {
+                    return;
+                };
+                if !CLOSEST || t_near <= t_max {
+                    current = next;
+                    break;
+                }
+            }
+        }
     }
 }
 
@@ -437,12 +436,6 @@ fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
         mask &= mask - 1;
         Some(i)
     })
-}
-
-thread_local! {
-    /// Each thread's traversal stack of (child, entry distance), reused by every query so that
-    /// none allocates or initialises one (queries do not nest: `leaf` never starts another).
-    static TRAVERSAL_STACK: std::cell::RefCell<Vec<(u32, f32)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Triangles under each node of a binary BVH.

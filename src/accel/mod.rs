@@ -118,56 +118,113 @@ impl Accel {
         }
     }
 
+    /// Run `f` with ray queries that share this thread's traversal stack: a batch of queries
+    /// (a stage of the wavefront) takes it once, rather than once per ray.
+    #[inline]
+    pub fn queries<R>(&self, f: impl FnOnce(&mut Queries<'_>) -> R) -> R {
+        TRAVERSAL_STACK.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stack) => f(&mut Queries { accel: self, stack: &mut stack }),
+            // Queries started inside `f` (none of tessera's do) get a stack of their own.
+            Err(_) => f(&mut Queries { accel: self, stack: &mut Vec::new() }),
+        })
+    }
+
     /// The closest hit with `0 < t < ray.t_max`, if any.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let triangle = match &self.backend {
-            Backend::Empty => None,
-            Backend::Bvh4(bvh) => bvh.intersect(ray),
-            #[cfg(feature = "embree")]
-            Backend::Embree(scene) => scene.intersect(ray),
-        };
-        self.closer_sphere(ray, triangle)
-    }
-
-    /// `hit` (a triangle's, or none), or the closest sphere before it.
-    #[inline]
-    fn closer_sphere(&self, ray: &Ray, hit: Option<Hit>) -> Option<Hit> {
-        let Some(spheres) = &self.spheres else { return hit };
-        let before = Ray { t_max: hit.map_or(ray.t_max, |h| h.t), ..*ray };
-        match spheres.intersect(&before) {
-            Some((t, i)) => Some(Hit { t, primitive: self.triangle_count as u32 + i, b1: 0.0, b2: 0.0 }),
-            None => hit,
-        }
+        self.queries(|q| q.intersect(ray))
     }
 
     /// The closest hit of each of `rays` into `hits` (of the same length), as [`Accel::intersect`]
     /// gives it but for ties in distance. Rays of nearly one direction (a pixel's camera rays)
     /// are traced together as a packet, for less than each alone.
     pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        self.queries(|q| q.intersect_many(rays, hits))
+    }
+
+    /// True when any triangle or sphere lies on the ray with `0 < t < ray.t_max`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.queries(|q| q.occluded(ray))
+    }
+
+    /// `hit` (a triangle's, or none), or the closest sphere before it.
+    #[inline(always)]
+    fn closer_sphere(&self, ray: &Ray, hit: Option<Hit>) -> Option<Hit> {
+        match &self.spheres {
+            None => hit,
+            Some(spheres) => self.closer_sphere_of(spheres, ray, hit),
+        }
+    }
+
+    /// [`Accel::closer_sphere`] where the scene has spheres (kept out of line: most scenes have
+    /// none, and every query asks).
+    #[inline(never)]
+    fn closer_sphere_of(&self, spheres: &SphereSet, ray: &Ray, hit: Option<Hit>) -> Option<Hit> {
+        let before = Ray { t_max: hit.map_or(ray.t_max, |h| h.t), ..*ray };
+        match spheres.intersect(&before) {
+            Some((t, i)) => Some(Hit { t, primitive: self.triangle_count as u32 + i, b1: 0.0, b2: 0.0 }),
+            None => hit,
+        }
+    }
+}
+
+/// Ray queries into an [`Accel`] that share one traversal stack ([`Accel::queries`]).
+pub struct Queries<'a> {
+    accel: &'a Accel,
+    stack: &'a mut TraversalStack,
+}
+
+impl Queries<'_> {
+    /// The closest hit with `0 < t < ray.t_max`, if any.
+    #[inline]
+    pub fn intersect(&mut self, ray: &Ray) -> Option<Hit> {
+        let accel = self.accel;
+        let triangle = match &accel.backend {
+            Backend::Empty => None,
+            Backend::Bvh4(bvh) => bvh.intersect(ray, self.stack),
+            #[cfg(feature = "embree")]
+            Backend::Embree(scene) => scene.intersect(ray),
+        };
+        accel.closer_sphere(ray, triangle)
+    }
+
+    /// [`Accel::intersect_many`].
+    pub fn intersect_many(&mut self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit per ray");
+        let accel = self.accel;
         for (rays, hits) in rays.chunks(32).zip(hits.chunks_mut(32)) {
-            match &self.backend {
-                Backend::Bvh4(bvh) => bvh.intersect_many(rays, hits),
+            match &accel.backend {
+                Backend::Bvh4(bvh) => {
+                    bvh.intersect_many(rays, hits, self.stack);
+                    rays.iter().zip(hits).for_each(|(r, h)| *h = accel.closer_sphere(r, *h));
+                }
                 _ => rays.iter().zip(hits.iter_mut()).for_each(|(r, h)| *h = self.intersect(r)),
-            }
-            if let Backend::Bvh4(_) = &self.backend {
-                rays.iter().zip(hits).for_each(|(r, h)| *h = self.closer_sphere(r, *h));
             }
         }
     }
 
     /// True when any triangle or sphere lies on the ray with `0 < t < ray.t_max`.
     #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        let triangle = match &self.backend {
+    pub fn occluded(&mut self, ray: &Ray) -> bool {
+        let accel = self.accel;
+        let triangle = match &accel.backend {
             Backend::Empty => false,
-            Backend::Bvh4(bvh) => bvh.occluded(ray),
+            Backend::Bvh4(bvh) => bvh.occluded(ray, self.stack),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.occluded(ray),
         };
-        triangle || self.spheres.as_ref().is_some_and(|s| s.occluded(ray))
+        triangle || accel.spheres.as_ref().is_some_and(|s| s.occluded(ray))
     }
+}
+
+/// A traversal stack of (child, entry distance) pairs ([`bvh4`]).
+type TraversalStack = Vec<(u32, f32)>;
+
+thread_local! {
+    /// Each thread's traversal stack, reused by every batch of queries so that none allocates
+    /// or initialises one.
+    static TRAVERSAL_STACK: std::cell::RefCell<TraversalStack> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// obvhs's binary BVH (leaves of up to four triangles: one packet), collapsed four-wide.
@@ -282,6 +339,24 @@ mod tests {
                 assert_eq!(expected.is_some(), accel.occluded(&ray));
             }
         }
+    }
+
+    #[test]
+    fn queries_started_inside_a_batch_get_their_own_stack() {
+        // A query inside `Accel::queries` finds the thread's stack taken: it must still answer,
+        // and answer alike.
+        let mut rng = Lcg(23);
+        let tris = random_scene(&mut rng, 500);
+        let accel = Accel::build(&tris, &[]);
+        let rays: Vec<Ray> = (0..200).map(|_| Ray::new(rng.vec(4.0), rng.vec(1.0))).collect();
+        accel.queries(|outer| {
+            for ray in &rays {
+                let inner = accel.intersect(ray);
+                assert_eq!(inner, outer.intersect(ray), "ray {ray:?}");
+                assert_eq!(accel.occluded(ray), outer.occluded(ray), "ray {ray:?}");
+                assert_eq!(inner.is_some(), accel.occluded(ray), "ray {ray:?}");
+            }
+        });
     }
 
     #[test]

@@ -152,14 +152,16 @@ impl<'a> PathTracer<'a> {
         while !active.is_empty() {
             shadow.clear();
             active.retain(|&i| self.shade(i, &mut paths[i], shadow));
-            for test in shadow.iter() {
-                if !self.scene.occluded(&test.ray) {
-                    paths[test.path].radiance += test.contribution;
+            self.scene.accel.queries(|queries| {
+                for test in shadow.iter() {
+                    if !queries.occluded(&test.ray) {
+                        paths[test.path].radiance += test.contribution;
+                    }
                 }
-            }
-            for &i in active.iter() {
-                paths[i].hit = self.scene.accel.intersect(&paths[i].ray);
-            }
+                for &i in active.iter() {
+                    paths[i].hit = queries.intersect(&paths[i].ray);
+                }
+            });
         }
     }
 

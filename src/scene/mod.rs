@@ -207,11 +207,6 @@ impl Scene {
         Some(self.interaction(ray, &self.accel.intersect(ray)?))
     }
 
-    /// True when something blocks `ray` before its `t_max`.
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        self.accel.occluded(ray)
-    }
-
     /// The surface that `ray` meets at `hit` (an answer of [`Scene::accel`] for `ray`).
     pub fn interaction(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction {
         let g = &self.geometry;
