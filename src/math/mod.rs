@@ -50,6 +50,13 @@ pub fn floor(x: f32) -> f32 {
     }
 }
 
+/// ceil(x) as [`floor`] computes floor(x), without a library call: -floor(-x), identical to
+/// `f32::ceil` except for the sign of a zero result.
+#[inline(always)]
+pub fn ceil(x: f32) -> f32 {
+    -floor(-x)
+}
+
 /// [`floor`] of each component.
 #[inline(always)]
 pub fn floor2(v: glam::Vec2) -> glam::Vec2 {
@@ -194,10 +201,16 @@ mod tests {
             assert_eq!(floor(x), x.floor(), "{x}");
         }
         assert!(floor(f32::NAN).is_nan());
+        assert!(ceil(f32::NAN).is_nan());
         let mut x = -1000.0f32;
         while x < 1000.0 {
             assert_eq!(floor(x), x.floor(), "{x}");
+            // Equal as numbers: -0.0 == 0.0, the one difference.
+            assert_eq!(ceil(x), x.ceil(), "{x}");
             x += 0.123_456_7;
+        }
+        for x in [0.0f32, -0.5, 0.5, 1e7 + 0.5, -1e7 - 0.5, 3e9, -3e9, f32::INFINITY, f32::NEG_INFINITY] {
+            assert_eq!(ceil(x), x.ceil(), "{x}");
         }
     }
 

@@ -4,7 +4,7 @@
 //! tiles of paper 001, each filtered on its own).
 
 use crate::image::Bitmap;
-use crate::math::{floor, floor2, wrap_index};
+use crate::math::{ceil, floor, floor2, wrap_index};
 use glam::{Vec2, Vec4};
 
 /// How an image texture is filtered over the hit's footprint.
@@ -372,7 +372,7 @@ impl MipMap {
         // The image repeats: start from the first period, so that the ellipse's bounds below are
         // a few texels apart however far out `st` is (far out, adjacent floats are millions of
         // texels apart, and the loops would run over all of them).
-        let st = if self.clamp { st } else { st - st.floor() };
+        let st = if self.clamp { st } else { st - floor2(st) };
         let c = st * res - Vec2::splat(0.5);
         let (d0, d1) = (dst0 * res, dst1 * res);
         // Implicit ellipse A x^2 + B x y + C y^2 < 1; the +1 keeps at least a texel's width.
@@ -387,10 +387,10 @@ impl MipMap {
         let inv_det = 1.0 / det;
         let u_sqrt = (det * cc).max(0.0).sqrt();
         let v_sqrt = (a * det).max(0.0).sqrt();
-        let s0 = (c.x - 2.0 * inv_det * u_sqrt).ceil() as i64;
-        let s1 = ((c.x + 2.0 * inv_det * u_sqrt).floor() as i64).min(s0 + MAX_EWA_SPAN);
-        let t0 = (c.y - 2.0 * inv_det * v_sqrt).ceil() as i64;
-        let t1 = ((c.y + 2.0 * inv_det * v_sqrt).floor() as i64).min(t0 + MAX_EWA_SPAN);
+        let s0 = ceil(c.x - 2.0 * inv_det * u_sqrt) as i64;
+        let s1 = (floor(c.x + 2.0 * inv_det * u_sqrt) as i64).min(s0 + MAX_EWA_SPAN);
+        let t0 = ceil(c.y - 2.0 * inv_det * v_sqrt) as i64;
+        let t1 = (floor(c.y + 2.0 * inv_det * v_sqrt) as i64).min(t0 + MAX_EWA_SPAN);
         let lut = &*EWA_WEIGHTS;
         let mut sum = T::ZERO;
         let mut weights = 0.0;

@@ -14,7 +14,7 @@
 //! (d = |F(u)(u - p)|, measured in map units): a band one tile wide on each side.
 
 use crate::image::Bitmap;
-use crate::math::largest_singular_value;
+use crate::math::{floor, largest_singular_value};
 use glam::{Mat2, Vec2};
 
 /// A point of a cut: its UV on both sides, its arc length and its developed coordinate (both in
@@ -348,7 +348,7 @@ impl CutBands {
         // psi(d) = 1 - smoothstep(d): flat at the cut and at the band's edge.
         let weight = 1.0 - d * d * (3.0 - 2.0 * d);
         let sigma = (s - curve.points[0].s) / h;
-        let m = (sigma.floor() as i64).clamp(0, self.anchors[c].len() as i64 - 2);
+        let m = (floor(sigma) as i64).clamp(0, self.anchors[c].len() as i64 - 2);
         let t = (sigma - m as f32).clamp(0.0, 1.0);
         let tile = |m: i64, w: f32| (m, w, g - self.anchors[c][m as usize] + offset);
         Some(BandLookup { weight, curve: r.curve, tiles: [tile(m, 1.0 - t), tile(m + 1, t)], reach: 2.0 * h })

@@ -14,7 +14,7 @@
 //! spread inside a footprint equals the exemplar's is the approximation this makes.
 
 use crate::image::Bitmap;
-use crate::math::{normal_cdf, normal_quantile};
+use crate::math::{floor, normal_cdf, normal_quantile};
 use crate::texture::{ImageTexture, MipMap, TexCtx};
 use glam::Vec4;
 
@@ -99,7 +99,7 @@ impl GaussianizedExemplar {
     /// `ctx`'s MIP level.
     pub fn invert(&self, g: Vec4, ctx: &TexCtx) -> Vec4 {
         let lod = self.gaussian.lod(ctx).clamp(0.0, (self.luts.len() - 1) as f32);
-        let level = lod.floor() as usize;
+        let level = floor(lod) as usize;
         let t = lod - level as f32;
         let at = |l: usize| Vec4::from_array(std::array::from_fn(|c| lut_lookup(&self.luts[l][c], g[c])));
         if t == 0.0 { at(level) } else { at(level) * (1.0 - t) + at(level + 1) * t }
