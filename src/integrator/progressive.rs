@@ -3,7 +3,8 @@
 //! previous pass's film, so that the image after any pass is the image of that many samples per
 //! pixel, bit for bit, and the final one that of an uninterrupted render. Passes double in
 //! length from one sample per pixel, bounded by the time left and a longest pass, so that a
-//! time limit is kept and an interruption loses little.
+//! time limit is kept and an interruption loses little; a remainder shorter than a pass joins
+//! it (64 samples per pixel: passes of 1, 2, 4, 8, 16 and 33).
 
 use super::{Crop, render_samples};
 use crate::image::Film;
@@ -55,6 +56,7 @@ pub fn render_in_passes(
     let mut film = start_film;
     let (mut done, mut pass) = (resumed, 1u32);
     while done < spp {
+        pass = with_remainder(pass, done, spp);
         if let Some(limit) = limits.time_limit {
             // Keep within the limit: no more samples than the time left allows at the rate so far.
             let elapsed = start.elapsed();
@@ -83,4 +85,39 @@ pub fn render_in_passes(
         pass = pass.saturating_mul(2);
     }
     Ok((film, done, Ending::Complete))
+}
+
+/// The length of a pass of `pass` samples per pixel after `done` of `spp`: all that is left when
+/// the remainder after it would be shorter than it. A pass of a few samples per pixel costs
+/// more than its share (a sweep over every tile, camera packets of few rays).
+fn with_remainder(pass: u32, done: u32, spp: u32) -> u32 {
+    let left = spp - done;
+    if left < pass.saturating_mul(2) { left } else { pass }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pass lengths of a render of `spp` samples per pixel without limits.
+    fn schedule(spp: u32) -> Vec<u32> {
+        let (mut done, mut pass, mut lengths) = (0, 1u32, Vec::new());
+        while done < spp {
+            pass = with_remainder(pass, done, spp);
+            lengths.push(pass);
+            done += pass;
+            pass = pass.saturating_mul(2);
+        }
+        lengths
+    }
+
+    #[test]
+    fn passes_double_and_a_short_remainder_joins_the_last() {
+        assert_eq!(schedule(1), [1]);
+        assert_eq!(schedule(6), [1, 2, 3]);
+        assert_eq!(schedule(64), [1, 2, 4, 8, 16, 33]);
+        assert_eq!(schedule(100), [1, 2, 4, 8, 16, 32, 37]);
+        assert_eq!(schedule(127), [1, 2, 4, 8, 16, 32, 64]);
+        assert_eq!(schedule(u32::MAX).iter().map(|&p| p as u64).sum::<u64>(), u32::MAX as u64);
+    }
 }
