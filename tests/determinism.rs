@@ -145,17 +145,16 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
 
 #[test]
 fn a_path_traced_in_a_wave_is_the_path_traced_alone() {
-    // The wavefront shades, shadow-tests and traces its paths stage by stage; each path's
-    // radiance and first hit must be what it gives traced on its own, bit for bit.
+    // The wavefront traces its camera rays as packets, then shades, shadow-tests and traces its
+    // paths stage by stage; each path's radiance and first hit must be what it gives traced on
+    // its own, bit for bit.
     let (_dir, scene) = common::scene(&everything_scene(), &[]);
     let tracer = PathTracer::new(&scene, true, true);
     let start = |pixel: u32, sample: u32| -> Path {
         let mut sampler = PixelKey::new(7, pixel as u64).sampler(sample);
         let film = glam::Vec2::new((pixel % 24) as f32, (pixel / 24) as f32) + sampler.next_2d();
         let (ray, diff) = scene.camera.generate_ray(film, glam::Vec2::ZERO);
-        let mut path = tracer.start(ray, diff, sampler);
-        path.set_primary_hit(scene.accel.intersect(&ray));
-        path
+        tracer.start(ray, diff, sampler)
     };
     let starts: Vec<(u32, u32)> = (0..24 * 20).flat_map(|pixel| (0..3).map(move |sample| (pixel, sample))).collect();
     let mut wave: Vec<Path> = starts.iter().map(|&(pixel, sample)| start(pixel, sample)).collect();

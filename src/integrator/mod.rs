@@ -11,20 +11,16 @@ pub use path::{FirstHit, Path, PathTracer, WaveBuffers};
 pub use progressive::{Ending, PassLimits, render_in_passes};
 
 use crate::color::Rgb;
-use crate::geometry::Ray;
 use crate::image::{Aov, Film};
 use crate::sampling::PixelKey;
 use crate::scene::Scene;
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Side of the square tiles work is split into.
 const TILE: u32 = 16;
-
-/// A pixel's camera rays are traced this many at a time, as a packet.
-const PACKET: usize = 8;
 
 /// About this many paths are traced as one wavefront ([`PathTracer::trace_wave`]): whole
 /// pixels' samples, at least one pixel's.
@@ -117,7 +113,6 @@ pub fn render_samples(
         }
         let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
         let mut aov_buf = vec![0.0f32; stride];
-        let mut primary = [None; PACKET];
         let mut paths = Vec::new();
         let mut buffers = WaveBuffers::default();
         let tile_pixels: Vec<(u32, u32)> = (ty * TILE..((ty + 1) * TILE).min(h))
@@ -131,31 +126,14 @@ pub fn render_samples(
             for &(fx, fy) in wave {
                 let (px, py) = (crop.x0 + fx, crop.y0 + fy);
                 let key = PixelKey::new(s.seed, py as u64 * s.width as u64 + px as u64);
-                let camera_sample = |i: u32| {
+                for i in samples.clone() {
                     let mut sampler = key.sampler(i);
                     let film_pos = s.pixel_filter.film_position(px, py, sampler.next_2d());
                     // A thin lens takes the next two dimensions; other cameras none, so that
                     // their paths draw the same numbers as before lenses existed.
                     let lens = if scene.camera.needs_lens_sample() { sampler.next_2d() } else { Vec2::ZERO };
                     let (ray, diff) = scene.camera.generate_ray(film_pos, lens);
-                    (ray, diff, sampler)
-                };
-                // The camera rays of up to PACKET samples at a time are traced together, as a
-                // packet (`Accel::intersect_many`).
-                for first in samples.clone().step_by(PACKET) {
-                    let count = (samples.end - first).min(PACKET as u32) as usize;
-                    let start = paths.len();
-                    // Only the first `count` slots are filled and traced.
-                    let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
-                    for (k, ray) in rays.iter_mut().enumerate().take(count) {
-                        let (camera_ray, diff, sampler) = camera_sample(first + k as u32);
-                        *ray = camera_ray;
-                        paths.push(tracer.start(camera_ray, diff, sampler));
-                    }
-                    scene.accel.intersect_many(&rays[..count], &mut primary[..count]);
-                    for (path, hit) in paths[start..].iter_mut().zip(primary) {
-                        path.set_primary_hit(hit);
-                    }
+                    paths.push(tracer.start(ray, diff, sampler));
                 }
             }
             tracer.trace_wave(&mut paths, &mut buffers);

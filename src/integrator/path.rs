@@ -83,14 +83,6 @@ pub struct Path {
     pub first_hit: Option<FirstHit>,
 }
 
-impl Path {
-    /// Set the closest hit of the camera ray (the renderer traces a pixel's camera rays
-    /// together, as a packet).
-    pub fn set_primary_hit(&mut self, hit: Option<Hit>) {
-        self.hit = hit;
-    }
-}
-
 /// A light sample waiting for its shadow ray: the path it belongs to and what it adds.
 struct ShadowTest {
     path: usize,
@@ -103,6 +95,8 @@ struct ShadowTest {
 pub struct WaveBuffers {
     active: Vec<usize>,
     shadow: Vec<ShadowTest>,
+    camera_rays: Vec<Ray>,
+    camera_hits: Vec<Option<Hit>>,
 }
 
 impl<'a> PathTracer<'a> {
@@ -126,7 +120,7 @@ impl<'a> PathTracer<'a> {
     }
 
     /// A path that starts with the camera ray `ray` (differentials `diff`), drawing its random
-    /// numbers from `sampler`; its closest hit is set by [`Path::set_primary_hit`].
+    /// numbers from `sampler`, for [`PathTracer::trace_wave`].
     pub fn start(&self, ray: Ray, diff: RayDifferential, sampler: Sampler) -> Path {
         Path {
             ray,
@@ -143,10 +137,21 @@ impl<'a> PathTracer<'a> {
         }
     }
 
-    /// Trace every path of `paths` to its end: shade all at their vertices, test all their
-    /// shadow rays, trace all their next rays, and again.
+    /// Trace every path of `paths` (fresh from [`PathTracer::start`]) to its end: trace all
+    /// their camera rays, then shade all at their vertices, test all their shadow rays, trace
+    /// all their next rays, and again.
     pub fn trace_wave(&self, paths: &mut [Path], buffers: &mut WaveBuffers) {
-        let WaveBuffers { active, shadow } = buffers;
+        let WaveBuffers { active, shadow, camera_rays, camera_hits } = buffers;
+        // Neighbouring camera rays (a pixel's samples, or neighbouring pixels' in a pass of few
+        // samples) are nearly parallel: the accelerator traces them as packets.
+        camera_rays.clear();
+        camera_rays.extend(paths.iter().map(|p| p.ray));
+        camera_hits.clear();
+        camera_hits.resize(paths.len(), None);
+        self.scene.accel.intersect_many(camera_rays, camera_hits);
+        for (path, hit) in paths.iter_mut().zip(camera_hits.iter()) {
+            path.hit = *hit;
+        }
         active.clear();
         active.extend(0..paths.len());
         while !active.is_empty() {
