@@ -52,31 +52,25 @@ pub struct Conductor {
 }
 
 impl Conductor {
-    /// f |cos theta_i| = F D G / (4 cos_o) for a rough conductor; 0 for a mirror (delta).
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    /// f |cos theta_i| = F D G / (4 cos_o) for a rough conductor, and the visible-normal
+    /// density of the reflected direction, D(m) G1(wo, m) / (4 cos_o), which share the half
+    /// vector m, D and G1(wo, m); both 0 for a mirror (delta).
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         let Some(ggx) = self.ggx else {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         };
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         }
         let m = (wo + wi).normalize();
         let d = ggx.d(m);
         if d == 0.0 {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         }
-        let g = ggx.g(wo, wi, m);
-        self.fresnel.eval(wo.dot(m)) * self.specular_reflectance * (d * g / (4.0 * wo.z))
-    }
-
-    /// Visible-normal density of the reflected direction: D(m) G1(wo, m) / (4 cos_o).
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some(ggx) = self.ggx else { return 0.0 };
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let m = (wo + wi).normalize();
-        ggx.d(m) * ggx.g1(wo, m) / (4.0 * wo.z)
+        let g1_o = ggx.g1(wo, m);
+        let g = g1_o * ggx.g1(wi, m);
+        let f = self.fresnel.eval(wo.dot(m)) * self.specular_reflectance * (d * g / (4.0 * wo.z));
+        (f, d * g1_o / (4.0 * wo.z))
     }
 
     /// Mirror reflection, or a reflection about a visible microfacet normal; the weight of the

@@ -46,40 +46,30 @@ impl Dielectric {
 
     /// f |cos theta_i|: the reflection lobe F D G / (4 |cos_o|), the transmission lobe
     /// (1 - F) D G |wo.m| |wi.m| / (|cos_o| (wo.m + eta wi.m)^2) (Walter et al., Eq. 21, with
-    /// the 1/eta^2 radiance scaling). 0 for a smooth interface (delta).
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    /// the 1/eta^2 radiance scaling); and the density of [`Dielectric::sample`]: visible-normal
+    /// density times the lobe probability (F or 1 - F) times the Jacobian of the half-vector
+    /// map. Both 0 for a smooth interface (delta).
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         let Some(ggx) = self.ggx else {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         };
         let Some(h) = self.half_vector(wo, wi) else {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         };
         let d = ggx.d(h.m);
-        let f = fresnel_dielectric(wo.dot(h.m), self.eta).r;
+        let (om, im) = (wo.dot(h.m), wi.dot(h.m));
+        let f = fresnel_dielectric(om, self.eta).r;
         let g = ggx.g(wo, wi, h.m);
-        if h.reflect {
+        let value = if h.reflect {
             self.specular_reflectance * (f * d * g / (4.0 * wo.z.abs()))
         } else {
-            let (om, im) = (wo.dot(h.m), wi.dot(h.m));
             let denom = om + h.eta * im;
-            let value = ((1.0 - f) * d * g * om * im / (wo.z * denom * denom)).abs();
-            self.specular_transmittance * value
-        }
-    }
-
-    /// Density of [`Dielectric::sample`]: visible-normal density times the lobe probability
-    /// (F or 1 - F) times the Jacobian of the half-vector map.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some(ggx) = self.ggx else { return 0.0 };
-        let Some(h) = self.half_vector(wo, wi) else {
-            return 0.0;
+            self.specular_transmittance * ((1.0 - f) * d * g * om * im / (wo.z * denom * denom)).abs()
         };
-        let (om, im) = (wo.dot(h.m), wi.dot(h.m));
         let dm_dwi = if h.reflect { 1.0 / (4.0 * im) } else { h.eta * h.eta * im / (om + h.eta * im).powi(2) };
-        let f = fresnel_dielectric(om, self.eta).r;
         let lobe = if h.reflect { f } else { 1.0 - f };
         let wo_front = if wo.z < 0.0 { -wo } else { wo };
-        (ggx.pdf_visible(wo_front, h.m) * lobe * dm_dwi).abs()
+        (value, (ggx.pdf_visible(wo_front, h.m) * lobe * dm_dwi).abs())
     }
 
     /// Choose reflection with probability F, else refraction, about the macro normal (smooth)

@@ -15,17 +15,14 @@ pub struct Diffuse {
 }
 
 impl Diffuse {
-    /// f |cos theta_i| = reflectance cos theta_i / pi on the front side, 0 elsewhere.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
+    /// f |cos theta_i| = reflectance cos theta_i / pi on the front side, 0 elsewhere, and the
+    /// cosine-weighted hemisphere density.
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if wo.z <= 0.0 {
+            return (Rgb::ZERO, 0.0);
         }
-        self.reflectance * (wi.z * FRAC_1_PI)
-    }
-
-    /// Cosine-weighted hemisphere density.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 { 0.0 } else { warp::cosine_hemisphere_pdf(wi) }
+        let f = if wi.z <= 0.0 { Rgb::ZERO } else { self.reflectance * (wi.z * FRAC_1_PI) };
+        (f, warp::cosine_hemisphere_pdf(wi))
     }
 
     /// Cosine-weighted sampling; the weight is the albedo.

@@ -5,6 +5,7 @@
 //!   one), both unit vectors in the local frame where the shading normal is +z;
 //! - `eval(wo, wi)` returns f(wo, wi) |cos theta_i|: the cosine is included;
 //! - `pdf(wo, wi)` is the solid-angle density with which `sample(wo, ..)` returns `wi`;
+//!   each model computes the two together (`eval_pdf`), as next-event estimation needs both;
 //! - `sample` returns the direction and its weight f |cos| / pdf. Delta lobes (smooth mirrors
 //!   and glass) have `eval = pdf = 0` and are only reached through `sample`.
 //!
@@ -62,26 +63,26 @@ pub enum Bsdf<'a> {
 }
 
 impl Bsdf<'_> {
-    /// f(wo, wi) |cos theta_i|.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    /// f(wo, wi) |cos theta_i| and the solid-angle density of sampling `wi` given `wo`,
+    /// computed together: they share most of their terms (the half vector, D, G1, Fresnel).
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         match self {
-            Bsdf::Diffuse(b) => b.eval(wo, wi),
-            Bsdf::Conductor(b) => b.eval(wo, wi),
-            Bsdf::Dielectric(b) => b.eval(wo, wi),
-            Bsdf::Plastic(b) => b.eval(wo, wi),
-            Bsdf::Pbr(b) => b.eval(wo, wi),
+            Bsdf::Diffuse(b) => b.eval_pdf(wo, wi),
+            Bsdf::Conductor(b) => b.eval_pdf(wo, wi),
+            Bsdf::Dielectric(b) => b.eval_pdf(wo, wi),
+            Bsdf::Plastic(b) => b.eval_pdf(wo, wi),
+            Bsdf::Pbr(b) => b.eval_pdf(wo, wi),
         }
     }
 
-    /// Solid-angle density of sampling `wi` given `wo`.
+    /// f(wo, wi) |cos theta_i| ([`Bsdf::eval_pdf`]'s first half).
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.eval_pdf(wo, wi).0
+    }
+
+    /// Solid-angle density of sampling `wi` given `wo` ([`Bsdf::eval_pdf`]'s second half).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
-            Bsdf::Diffuse(b) => b.pdf(wo, wi),
-            Bsdf::Conductor(b) => b.pdf(wo, wi),
-            Bsdf::Dielectric(b) => b.pdf(wo, wi),
-            Bsdf::Plastic(b) => b.pdf(wo, wi),
-            Bsdf::Pbr(b) => b.pdf(wo, wi),
-        }
+        self.eval_pdf(wo, wi).1
     }
 
     /// Sample `wi` given `wo`, with a uniform number `u1` to choose a lobe and `u2` for the

@@ -50,30 +50,22 @@ impl<'a> Pbr<'a> {
         }
     }
 
-    /// metallic f_metal + (1 - metallic) f_dielectric, times |cos theta_i|.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    /// metallic f_metal + (1 - metallic) f_dielectric, times |cos theta_i|, and the same blend
+    /// of the two lobes' densities.
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         let m = self.metallic;
-        let mut f = Rgb::ZERO;
+        let (mut f, mut p) = (Rgb::ZERO, 0.0);
         if m > 0.0 {
-            f += self.metal().eval(wo, wi) * m;
+            let (f_metal, p_metal) = self.metal().eval_pdf(wo, wi);
+            f += f_metal * m;
+            p += p_metal * m;
         }
         if m < 1.0 {
-            f += self.dielectric().eval(wo, wi) * (1.0 - m);
+            let (f_dielectric, p_dielectric) = self.dielectric().eval_pdf(wo, wi);
+            f += f_dielectric * (1.0 - m);
+            p += p_dielectric * (1.0 - m);
         }
-        f
-    }
-
-    /// The same blend of the two lobes' densities.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let m = self.metallic;
-        let mut p = 0.0;
-        if m > 0.0 {
-            p += self.metal().pdf(wo, wi) * m;
-        }
-        if m < 1.0 {
-            p += self.dielectric().pdf(wo, wi) * (1.0 - m);
-        }
-        p
+        (f, p)
     }
 
     /// Choose the metal with probability `metallic`, sample it, weight by the whole blend.
@@ -85,10 +77,10 @@ impl<'a> Pbr<'a> {
             let u1 = if m > 0.0 { ((u1 - m) / (1.0 - m)).clamp(0.0, 1.0 - f32::EPSILON) } else { u1 };
             self.dielectric().sample(wo, u1, u2)?.wi
         };
-        let pdf = self.pdf(wo, wi);
+        let (f, pdf) = self.eval_pdf(wo, wi);
         if !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false, eta: 1.0 })
+        Some(BsdfSample { wi, weight: f / pdf, pdf, delta: false, eta: 1.0 })
     }
 }

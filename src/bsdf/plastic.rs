@@ -158,34 +158,26 @@ impl Plastic<'_> {
         if ps + pd > 0.0 { ps / (ps + pd) } else { 0.5 }
     }
 
-    /// f |cos theta_i| of the coating plus the base.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    /// f |cos theta_i| of the coating plus the base, and the mixture density of the two lobes
+    /// (they share the half vector, D, G1(wo) and the coating's transmittance towards wo).
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::ZERO;
+            return (Rgb::ZERO, 0.0);
         }
         let ggx = self.ggx();
         let eta = self.tables.eta;
         let m = (wo + wi).normalize();
+        let (d, g1_o) = (ggx.d(m), ggx.g1(wo, m));
         let f = fresnel_dielectric(wo.dot(m), eta).r;
-        let specular = self.specular_reflectance * (f * ggx.d(m) * ggx.g(wo, wi, m) / (4.0 * wo.z));
+        let specular = self.specular_reflectance * (f * d * (g1_o * ggx.g1(wi, m)) / (4.0 * wo.z));
         let alpha = self.tables.alpha_lerp(self.alpha);
         let t_o = self.tables.transmittance(alpha, wo.z);
         let t_i = self.tables.transmittance(alpha, wi.z);
         let diffuse = self.diffuse_reflectance / (1.0 - self.tables.internal_reflectance(alpha));
-        specular + diffuse * (FRAC_1_PI / (eta * eta) * wi.z * t_o * t_i)
-    }
-
-    /// Mixture density of the two lobes.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let t_o = self.tables.transmittance(self.tables.alpha_lerp(self.alpha), wo.z);
+        let value = specular + diffuse * (FRAC_1_PI / (eta * eta) * wi.z * t_o * t_i);
         let p_spec = self.specular_probability(t_o);
-        let ggx = self.ggx();
-        let m = (wo + wi).normalize();
-        let pdf_spec = ggx.d(m) * ggx.g1(wo, m) / (4.0 * wo.z);
-        p_spec * pdf_spec + (1.0 - p_spec) * warp::cosine_hemisphere_pdf(wi)
+        let pdf_spec = d * g1_o / (4.0 * wo.z);
+        (value, p_spec * pdf_spec + (1.0 - p_spec) * warp::cosine_hemisphere_pdf(wi))
     }
 
     /// Pick the coating or the base, sample it, and weight by the full mixture.
@@ -202,11 +194,11 @@ impl Plastic<'_> {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
+        let (f, pdf) = self.eval_pdf(wo, wi);
         if !(pdf > 0.0) {
             return None;
         }
-        Some(BsdfSample { wi, weight: self.eval(wo, wi) / pdf, pdf, delta: false, eta: 1.0 })
+        Some(BsdfSample { wi, weight: f / pdf, pdf, delta: false, eta: 1.0 })
     }
 }
 
