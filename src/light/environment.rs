@@ -96,10 +96,9 @@ impl EnvironmentMap {
         let (w, h) = (self.image.width, self.image.height);
         let x = uv.x * w as f32 - 0.5;
         let y = (uv.y * (h - 1) as f32).clamp(0.0, (h - 1) as f32);
-        let (x0, y0) = (crate::math::floor(x), crate::math::floor(y));
-        let (fx, fy) = (x - x0, y - y0);
-        let col = |c: f32| crate::math::wrap_index(c as i64, w);
-        let (c0, c1) = (col(x0), col(x0 + 1.0));
+        let ((x0, fx), (y0, fy)) = (crate::math::floor_index(x), crate::math::floor_index(y));
+        let col = |c: i64| crate::math::wrap_index(c, w);
+        let (c0, c1) = (col(x0), col(x0 + 1));
         let r0 = y0 as usize;
         let r1 = (r0 + 1).min(h - 1);
         let px = |c: usize, r: usize| Rgb::from_vec4(self.image.pixel(c, r));

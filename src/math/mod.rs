@@ -50,6 +50,17 @@ pub fn floor(x: f32) -> f32 {
     }
 }
 
+/// floor(x) as an integer, and the fraction x - floor(x): a texel's index and weight, for
+/// |x| < 2^23 (beyond, the integer saturates at i32's range). One conversion to an integer,
+/// none back: [`floor`] then a cast converts twice. The fraction is bit for bit x - floor(x);
+/// NaN gives index 0 and a NaN fraction, as `floor(x) as i64` and x - floor(x) do.
+#[inline(always)]
+pub fn floor_index(x: f32) -> (i64, f32) {
+    let t = x as i32;
+    let i = if t as f32 > x { t - 1 } else { t };
+    (i as i64, x - i as f32)
+}
+
 /// ceil(x) as [`floor`] computes floor(x), without a library call: -floor(-x), identical to
 /// `f32::ceil` except for the sign of a zero result.
 #[inline(always)]
@@ -212,6 +223,24 @@ mod tests {
         for x in [0.0f32, -0.5, 0.5, 1e7 + 0.5, -1e7 - 0.5, 3e9, -3e9, f32::INFINITY, f32::NEG_INFINITY] {
             assert_eq!(ceil(x), x.ceil(), "{x}");
         }
+    }
+
+    #[test]
+    fn floor_index_is_the_floor_and_its_fraction() {
+        let mut x = -5000.0f32;
+        while x < 5000.0 {
+            let (i, fraction) = floor_index(x);
+            assert_eq!(i, x.floor() as i64, "{x}");
+            assert_eq!(fraction.to_bits(), (x - x.floor()).to_bits(), "{x}");
+            x += 0.013_7;
+        }
+        for x in [-0.0f32, -1e-30, 1e-30, 8_388_607.5, -8_388_607.5, 4_194_303.5] {
+            let (i, fraction) = floor_index(x);
+            assert_eq!((i, fraction), (x.floor() as i64, x - x.floor()), "{x}");
+        }
+        let (i, fraction) = floor_index(f32::NAN);
+        assert_eq!(i, 0);
+        assert!(fraction.is_nan());
     }
 
     #[test]

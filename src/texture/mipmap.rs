@@ -4,7 +4,7 @@
 //! tiles of paper 001, each filtered on its own).
 
 use crate::image::Bitmap;
-use crate::math::{ceil, floor, floor2, wrap_index};
+use crate::math::{ceil, floor, floor_index, floor2, wrap_index};
 use glam::{Vec2, Vec4};
 
 /// How an image texture is filtered over the hit's footprint.
@@ -216,9 +216,7 @@ impl MipMap {
         let l = &self.levels[level];
         let x = st.x * l.width as f32 - 0.5;
         let y = st.y * l.height as f32 - 0.5;
-        let (x0, y0) = (floor(x), floor(y));
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
+        let ((x0, fx), (y0, fy)) = (floor_index(x), floor_index(y));
         let (x0, x1) = (self.index(x0, l.width), self.index(x0 + 1, l.width));
         let (y0, y1) = (self.index(y0, l.height), self.index(y0 + 1, l.height));
         let top = texel(x0, y0) * (1.0 - fx) + texel(x1, y0) * fx;
