@@ -69,7 +69,7 @@ impl Lights {
     /// Probability of choosing any one light.
     #[inline]
     pub fn selection_pdf(&self) -> f32 {
-        1.0 / self.count().max(1) as f32
+        1.0 / self.count().max(1) as u32 as f32
     }
 
     /// Choose a light uniformly with `u_select` and sample it from `p` with `u`.
@@ -78,7 +78,9 @@ impl Lights {
         if n == 0 {
             return None;
         }
-        let i = ((u_select * n as f32) as usize).min(n - 1);
+        // Through u32, which x86-64 converts to and from f32 in one or two instructions (u64 and
+        // usize take a branch each way); no scene holds 2^32 lights.
+        let i = ((u_select * n as u32 as f32) as u32 as usize).min(n - 1);
         let (points, distant) = (self.area.len(), self.area.len() + self.points.len());
         let environment = distant + self.distant.len();
         let mut s = match i {
