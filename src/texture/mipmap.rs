@@ -111,8 +111,11 @@ fn downsample_axis(src: &Bitmap, new_len: usize, horizontal: bool) -> Bitmap {
 #[inline(always)]
 fn ewa_weight(lut: &[f32; EWA_LUT_SIZE], r2: f32) -> f32 {
     let x = r2 * (EWA_LUT_SIZE - 1) as f32;
-    let i = (x as usize).min(EWA_LUT_SIZE - 2);
+    // Through u32, which x86-64 converts to and from f32 in an instruction or two (usize takes
+    // a branch each way); the same saturation at 0 for negative r2 and NaN.
+    let i = (x as u32).min(EWA_LUT_SIZE as u32 - 2);
     let t = x - i as f32;
+    let i = i as usize;
     lut[i] * (1.0 - t) + lut[i + 1] * t
 }
 
