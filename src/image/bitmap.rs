@@ -1,6 +1,6 @@
 //! A float image with 1 to 4 channels.
 
-use glam::Vec4;
+use glam::{Vec2, Vec4};
 
 /// How the integer values of an image file encode colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize, serde::Serialize)]
@@ -30,6 +30,15 @@ impl Bitmap {
     pub fn new(width: usize, height: usize, channels: usize) -> Self {
         assert!((1..=4).contains(&channels));
         Bitmap { width, height, channels, data: vec![0.0; width * height * channels] }
+    }
+
+    /// Width and height as floats, for texel addressing. Converted through u32, which x86-64
+    /// turns into a float in one instruction where usize takes a branch: no image comes near
+    /// 2^32 texels a side (`limits::MAX_IMAGE_SIDE`; a side of 2^32 would be 16 GB a row).
+    #[inline(always)]
+    pub fn size_f32(&self) -> Vec2 {
+        debug_assert!(self.width <= u32::MAX as usize && self.height <= u32::MAX as usize);
+        Vec2::new(self.width as u32 as f32, self.height as u32 as f32)
     }
 
     /// The pixel at column `x`, row `y` as RGBA: grey is replicated, missing alpha is 1.

@@ -217,8 +217,9 @@ impl MipMap {
     #[inline(always)]
     fn bilinear_of<T: Texel>(&self, level: usize, st: Vec2, texel: impl Fn(usize, usize) -> T) -> T {
         let l = &self.levels[level];
-        let x = st.x * l.width as f32 - 0.5;
-        let y = st.y * l.height as f32 - 0.5;
+        let size = l.size_f32();
+        let x = st.x * size.x - 0.5;
+        let y = st.y * size.y - 0.5;
         let ((x0, fx), (y0, fy)) = (floor_index(x), floor_index(y));
         let (x0, x1) = (self.index(x0, l.width), self.index(x0 + 1, l.width));
         let (y0, y1) = (self.index(y0, l.height), self.index(y0 + 1, l.height));
@@ -315,7 +316,7 @@ impl MipMap {
     }
 
     fn size(&self) -> Vec2 {
-        Vec2::new(self.levels[0].width as f32, self.levels[0].height as f32)
+        self.levels[0].size_f32()
     }
 
     /// Level of a trilinear lookup: where the footprint's bounding square spans one texel.
@@ -332,8 +333,10 @@ impl MipMap {
     /// Blend `f` of the two levels around the continuous level `lod`.
     #[inline(always)]
     fn at_level<T: Texel>(&self, lod: f32, f: impl Fn(usize) -> T) -> T {
-        let i = lod as usize;
+        // Through u32, as `Bitmap::size_f32` converts (lod is at most the level count).
+        let i = lod as u32;
         let t = lod - i as f32;
+        let i = i as usize;
         if t == 0.0 || i + 1 >= self.levels.len() { f(i) } else { f(i) * (1.0 - t) + f(i + 1) * t }
     }
 
@@ -369,7 +372,7 @@ impl MipMap {
         texel: &impl Fn(usize, usize, usize) -> T,
     ) -> T {
         let l = &self.levels[level];
-        let res = Vec2::new(l.width as f32, l.height as f32);
+        let res = l.size_f32();
         // The image repeats: start from the first period, so that the ellipse's bounds below are
         // a few texels apart however far out `st` is (far out, adjacent floats are millions of
         // texels apart, and the loops would run over all of them).
