@@ -333,9 +333,8 @@ impl MipMap {
     /// Blend `f` of the two levels around the continuous level `lod`.
     #[inline(always)]
     fn at_level<T: Texel>(&self, lod: f32, f: impl Fn(usize) -> T) -> T {
-        // Through u32, as `Bitmap::size_f32` converts (lod is at most the level count).
-        let i = lod as u32;
-        let t = lod - i as f32;
+        // lod is not negative (or NaN: level 0, as the cast gives): its floor is its integer part.
+        let (i, t) = floor_index(lod);
         let i = i as usize;
         if t == 0.0 || i + 1 >= self.levels.len() { f(i) } else { f(i) * (1.0 - t) + f(i + 1) * t }
     }
