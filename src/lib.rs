@@ -53,6 +53,7 @@ pub mod regress;
 pub mod sampling;
 pub mod scene;
 pub mod shader;
+pub mod simd;
 pub mod texture;
 pub mod tiles;
 

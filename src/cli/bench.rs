@@ -6,6 +6,9 @@
 //!   rays (cosine-distributed bounces from the primary hits), on one thread and on all.
 //! - A full render of `scenes/brushed_metal.toml` (Mitsuba scene A: 512 x 512, 64 spp, max
 //!   depth 8): samples per second, against Mitsuba 3's figures measured on this kind of machine.
+//! - Shading arithmetic in SIMD lanes (issue 19): GGX visible-normal sampling of 1M directions,
+//!   one at a time as the path tracer calls it, and eight at a time in lanes (portable, and
+//!   AVX2 where the CPU has it), on one thread, as ratios to the first.
 //! - `tessera deform`'s computation (deformation gradients, polar decompositions, orientation,
 //!   a 256 x 256 smoothing grid, a 1024 x 1024 F map) on a lat-long UV sphere of 262k
 //!   triangles, one thread.
@@ -28,12 +31,13 @@
 //!   control points (the paper reports 30 s), and single lookups per second against the bitmap
 //!   lookup of the texture figures, measured in the same run.
 
-use glam::{Mat2, Vec2};
+use glam::{Mat2, Vec2, Vec3};
 use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 use tessera::accel::{Accel, AccelKind};
+use tessera::bsdf::Ggx;
 use tessera::camera::{Camera, CameraModel, FovAxis};
 use tessera::error::{Error, Result};
 use tessera::geometry::{Frame, Ray, offset_ray_origin, shapes};
@@ -41,6 +45,7 @@ use tessera::image::{Bitmap, ColorSpace, read_bitmap};
 use tessera::integrator::render;
 use tessera::sampling::{Sampler, warp};
 use tessera::scene::{SceneOverrides, load_scene};
+use tessera::simd::{F32x8, Isa, Real, V3};
 use tessera::texture::tiling_blending::{Blend, Deformation, DeformationField, PriorityMap, Synthesis, Tiling};
 use tessera::texture::{Filter, ImageTexture, MipMap, TexCtx, Texture, TilingBlending};
 
@@ -85,6 +90,9 @@ pub enum Suite {
     Render,
     /// Texture lookups: bitmap, classical and deformed tiling and blending.
     Textures,
+    /// Shading arithmetic in SIMD lanes: GGX visible-normal sampling one at a time and eight at
+    /// a time, portable and AVX2.
+    Lanes,
     /// `tessera deform` on a mesh of 262k triangles.
     Deform,
     /// Paper 001: mapping 1M quads, synthesising 16 tiles of 256 texels.
@@ -112,6 +120,9 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> R
     }
     if suites.contains(&Suite::Textures) {
         textures(scene_dir, runs)?;
+    }
+    if suites.contains(&Suite::Lanes) {
+        lanes(runs);
     }
     if suites.contains(&Suite::Deform) {
         deform(runs)?;
@@ -322,6 +333,54 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Scene A's conductor (alpha 0.05 x 0.3) sampling visible normals for 1M directions over the
+/// upper hemisphere: one at a time, as the path tracer calls it, and eight at a time in lanes
+/// with each instruction set this CPU has.
+fn lanes(runs: usize) {
+    let ggx = Ggx::new(0.05, 0.3);
+    let n = 1 << 20;
+    let mut sampler = Sampler::new(3, 0, 0);
+    let inputs: Vec<(Vec3, Vec2)> =
+        (0..n).map(|_| (warp::square_to_cosine_hemisphere(sampler.next_2d()), sampler.next_2d())).collect();
+    let lanes: Vec<(V3<F32x8>, [F32x8; 2])> = inputs
+        .chunks_exact(8)
+        .map(|c| {
+            let w = V3::new(F32x8::from_fn(|i| c[i].0.x), F32x8::from_fn(|i| c[i].0.y), F32x8::from_fn(|i| c[i].0.z));
+            (w, [F32x8::from_fn(|i| c[i].1.x), F32x8::from_fn(|i| c[i].1.y)])
+        })
+        .collect();
+    let rate = |f: &dyn Fn() -> f32| {
+        median(
+            (0..runs)
+                .map(|_| {
+                    let start = Instant::now();
+                    std::hint::black_box(f());
+                    n as f64 / start.elapsed().as_secs_f64() / 1e6
+                })
+                .collect(),
+        )
+    };
+    let scalar = rate(&|| inputs.iter().map(|&(w, u)| ggx.sample_visible(std::hint::black_box(w), u).z).sum());
+    println!("lanes      GGX visible normals (alpha 0.05 x 0.3), {n} samples on 1 thread:");
+    println!("           one at a time (f32)          {scalar:7.1} M samples/s  (1.00x)");
+    for isa in [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available()) {
+        let lanes = rate(&|| {
+            isa.run(|| {
+                let mut sum = F32x8::splat(0.0);
+                for &(w, u) in std::hint::black_box(&lanes) {
+                    sum = sum + ggx.sample_visible_of(w, u).z;
+                }
+                sum.0.iter().sum()
+            })
+        });
+        println!(
+            "           eight lanes, {:<16} {lanes:7.1} M samples/s  ({:.2}x)",
+            format!("{isa:?}"),
+            lanes / scalar
+        );
+    }
 }
 
 fn deform(runs: usize) -> Result<()> {

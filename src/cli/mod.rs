@@ -272,7 +272,7 @@ enum Command {
         #[arg(long, default_value = "scenes")]
         scenes: PathBuf,
         /// Which figures to measure, comma separated (default: all).
-        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures", "deform", "tiles", "pups"])]
+        #[arg(long, value_delimiter = ',', default_values = ["rays", "render", "textures", "lanes", "deform", "tiles", "pups"])]
         only: Vec<bench::Suite>,
     },
 }

@@ -1,0 +1,63 @@
+//! The instruction set that lane code runs with, chosen at run time: AVX2 where the CPU has
+//! it, else the baseline (SSE2 on x86-64, whatever the target has elsewhere). Either can be
+//! asked for, so that tests and benchmarks compare them.
+
+/// An instruction set for lane code ([`Isa::run`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// 256-bit AVX2 (x86-64 CPUs that have it).
+    Avx2,
+    /// The target's baseline: each eight-lane operation as two SSE2 operations on x86-64.
+    Portable,
+}
+
+impl Isa {
+    /// Whether this CPU runs `self`.
+    pub fn available(self) -> bool {
+        match self {
+            Isa::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            Isa::Avx2 => false,
+        }
+    }
+
+    /// The best instruction set this CPU runs.
+    pub fn detected() -> Isa {
+        if Isa::Avx2.available() { Isa::Avx2 } else { Isa::Portable }
+    }
+
+    /// `f()`, compiled for this instruction set: everything `f` inlines (lane operations are all
+    /// `#[inline(always)]`) is compiled for AVX2 under [`Isa::Avx2`]. Portable where `self` is
+    /// not [`Isa::available`].
+    #[inline(always)]
+    pub fn run<R>(self, f: impl FnOnce() -> R) -> R {
+        #[cfg(target_arch = "x86_64")]
+        if self == Isa::Avx2 && self.available() {
+            #[target_feature(enable = "avx2")]
+            #[allow(unsafe_code)]
+            unsafe fn with_avx2<R>(f: impl FnOnce() -> R) -> R {
+                f()
+            }
+            // SAFETY: the CPU has AVX2 (checked just above).
+            #[allow(unsafe_code)]
+            return unsafe { with_avx2(f) };
+        }
+        f()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_portable_set_is_always_available_and_run_calls_f() {
+        assert!(Isa::Portable.available());
+        assert!(Isa::detected().available());
+        for isa in [Isa::Avx2, Isa::Portable] {
+            assert_eq!(isa.run(|| 41 + 1), 42);
+        }
+    }
+}

@@ -1,0 +1,167 @@
+//! Arithmetic written once for one value or for eight SIMD lanes (issue 19; Mitsuba 3 writes its
+//! plugins once over `Float` the same way, for its scalar and its LLVM variants).
+//!
+//! A function generic over [`Real`] runs on `f32`, as the path tracer calls it today, or on
+//! [`F32x8`], eight paths' values at once. Branches become [`Real::select`]s: both sides are
+//! computed and one is kept, so that the `f32` instantiation returns what the branching code
+//! returned, bit for bit. Eight lanes compile to AVX2 where the CPU has it and to SSE2 (two
+//! halves) where not ([`Isa`]); both run the same IEEE operations in the same order, so they
+//! agree bit for bit. Lanes differ from `f32` only in [`Real::sin_cos`]: libm's for `f32`, a
+//! polynomial in lanes ([`trig`]).
+
+mod dispatch;
+mod lanes;
+pub mod trig;
+
+pub use dispatch::Isa;
+pub use lanes::{F32x8, M32x8};
+
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+/// Which lanes of a comparison held: `bool` for one value, [`M32x8`] for eight lanes.
+pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> {}
+
+impl Mask for bool {}
+
+/// A real number in one lane (`f32`) or eight ([`F32x8`]), with IEEE single-precision
+/// arithmetic in every lane.
+pub trait Real:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
+{
+    /// Lanes of a comparison.
+    type Mask: Mask;
+    /// `x` in every lane.
+    fn splat(x: f32) -> Self;
+    /// Square root (IEEE, correctly rounded).
+    fn sqrt(self) -> Self;
+    /// `f32::max` in every lane: the other operand where one is NaN.
+    fn max(self, other: Self) -> Self;
+    /// `self < other`, per lane (false for NaN).
+    fn lt(self, other: Self) -> Self::Mask;
+    /// `self <= other`, per lane (false for NaN).
+    fn le(self, other: Self) -> Self::Mask;
+    /// `self == other`, per lane (false for NaN).
+    fn eq(self, other: Self) -> Self::Mask;
+    /// `a` where `mask` holds, else `b`, per lane.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// (sin x, cos x): libm's for `f32`, [`trig::sin_cos`] in lanes.
+    fn sin_cos(self) -> (Self, Self);
+}
+
+impl Real for f32 {
+    type Mask = bool;
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f32::max(self, other)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        f32::sin_cos(self)
+    }
+}
+
+/// A 3-vector of [`Real`]s, with glam's `Vec3` operations in glam's order of operations, so
+/// that `V3<f32>` computes what `Vec3` computes bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3<T> {
+    /// x.
+    pub x: T,
+    /// y.
+    pub y: T,
+    /// z.
+    pub z: T,
+}
+
+impl<T: Real> V3<T> {
+    /// The vector (x, y, z).
+    #[inline(always)]
+    pub fn new(x: T, y: T, z: T) -> Self {
+        V3 { x, y, z }
+    }
+
+    /// x x' + y y' + z z'.
+    #[inline(always)]
+    pub fn dot(self, o: Self) -> T {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    /// The cross product.
+    #[inline(always)]
+    pub fn cross(self, o: Self) -> Self {
+        V3::new(self.y * o.z - o.y * self.z, self.z * o.x - o.z * self.x, self.x * o.y - o.x * self.y)
+    }
+
+    /// self / |self|, as glam computes it: self * (1 / sqrt(self . self)).
+    #[inline(always)]
+    pub fn normalize(self) -> Self {
+        self * (T::splat(1.0) / self.dot(self).sqrt())
+    }
+
+    /// `a` where `mask` holds, else `b`, per lane.
+    #[inline(always)]
+    pub fn select(mask: T::Mask, a: Self, b: Self) -> Self {
+        V3::new(T::select(mask, a.x, b.x), T::select(mask, a.y, b.y), T::select(mask, a.z, b.z))
+    }
+}
+
+impl<T: Real> Add for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        V3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl<T: Real> Mul<T> for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, s: T) -> Self {
+        V3::new(self.x * s, self.y * s, self.z * s)
+    }
+}
+
+impl<T: Real> Div<T> for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, s: T) -> Self {
+        V3::new(self.x / s, self.y / s, self.z / s)
+    }
+}
+
+impl From<glam::Vec3> for V3<f32> {
+    #[inline(always)]
+    fn from(v: glam::Vec3) -> Self {
+        V3::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<V3<f32>> for glam::Vec3 {
+    #[inline(always)]
+    fn from(v: V3<f32>) -> Self {
+        glam::Vec3::new(v.x, v.y, v.z)
+    }
+}
