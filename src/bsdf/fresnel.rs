@@ -1,6 +1,7 @@
 //! Fresnel reflectance of dielectric and conductor interfaces.
 
 use crate::color::Rgb;
+use crate::simd::{Real, V3};
 
 /// Fresnel reflectance of a dielectric interface and the refracted direction's data.
 #[derive(Clone, Copy, Debug)]
@@ -43,19 +44,26 @@ pub fn fresnel_dielectric(cos_theta_i: f32, eta: f32) -> FresnelDielectric {
 /// "Optics", 1988; the form Mitsuba 3 uses).
 pub fn fresnel_conductor(cos_theta_i: f32, eta: Rgb, k: Rgb) -> Rgb {
     // The three channels at once, one per SIMD lane.
+    fresnel_conductor_of(Rgb::splat(cos_theta_i), eta, k)
+}
+
+/// [`fresnel_conductor`] of one colour's channels (`Rgb`), or of one channel of eight paths.
+#[inline(always)]
+pub fn fresnel_conductor_of<C: Real>(cos_theta_i: C, eta: C, k: C) -> C {
+    let (zero, half) = (C::splat(0.0), C::splat(0.5));
     let c2 = cos_theta_i * cos_theta_i;
-    let s2 = 1.0 - c2;
+    let s2 = C::splat(1.0) - c2;
     let s4 = s2 * s2;
     let temp = eta * eta - k * k - s2;
-    let a2pb2 = (temp * temp + 4.0 * k * k * eta * eta).max(Rgb::ZERO).sqrt();
-    let a = (0.5 * (a2pb2 + temp)).max(Rgb::ZERO).sqrt();
+    let a2pb2 = (temp * temp + C::splat(4.0) * k * k * eta * eta).max(zero).sqrt();
+    let a = (half * (a2pb2 + temp)).max(zero).sqrt();
     let t1 = a2pb2 + c2;
-    let t2 = 2.0 * cos_theta_i * a;
+    let t2 = C::splat(2.0) * cos_theta_i * a;
     let rs = (t1 - t2) / (t1 + t2);
     let t3 = a2pb2 * c2 + s4;
     let t4 = t2 * s2;
     let rp = rs * (t3 - t4) / (t3 + t4);
-    0.5 * (rs + rp)
+    half * (rs + rp)
 }
 
 /// Schlick's approximation F0 + (1 - F0)(1 - cos)^5, the Fresnel term of glTF's metallic
@@ -70,7 +78,13 @@ pub fn fresnel_schlick(f0: Rgb, cos_theta_i: f32) -> Rgb {
 /// Reflect `w` about the microfacet normal `m` (local frame).
 #[inline]
 pub fn reflect(w: glam::Vec3, m: glam::Vec3) -> glam::Vec3 {
-    2.0 * w.dot(m) * m - w
+    reflect_of(w.into(), m.into()).into()
+}
+
+/// [`reflect`] in one lane or eight: 2 (w . m) m - w.
+#[inline(always)]
+pub fn reflect_of<T: Real>(w: V3<T>, m: V3<T>) -> V3<T> {
+    m * (T::splat(2.0) * w.dot(m)) - w
 }
 
 /// Refract `w` through the microfacet normal `m`, given the data of [`fresnel_dielectric`]

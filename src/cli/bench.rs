@@ -6,9 +6,10 @@
 //!   rays (cosine-distributed bounces from the primary hits), on one thread and on all.
 //! - A full render of `scenes/brushed_metal.toml` (Mitsuba scene A: 512 x 512, 64 spp, max
 //!   depth 8): samples per second, against Mitsuba 3's figures measured on this kind of machine.
-//! - Shading arithmetic in SIMD lanes (issue 19): GGX visible-normal sampling of 1M directions,
-//!   one at a time as the path tracer calls it, and eight at a time in lanes (portable, and
-//!   AVX2 where the CPU has it), on one thread, as ratios to the first.
+//! - Shading arithmetic in SIMD lanes (issue 19): scene A's aluminium at 1M directions, GGX
+//!   visible-normal sampling alone and the conductor's sample and evaluation with their Fresnel
+//!   colours, one at a time as the path tracer calls them and eight at a time in lanes
+//!   (portable, and AVX2 where the CPU has it), on one thread, as ratios to the first.
 //! - `tessera deform`'s computation (deformation gradients, polar decompositions, orientation,
 //!   a 256 x 256 smoothing grid, a 1024 x 1024 F map) on a lat-long UV sphere of 262k
 //!   triangles, one thread.
@@ -37,8 +38,10 @@ use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 use tessera::accel::{Accel, AccelKind};
-use tessera::bsdf::Ggx;
+use tessera::bsdf::fresnel::fresnel_conductor_of;
+use tessera::bsdf::{Conductor, ConductorFresnel, Ggx};
 use tessera::camera::{Camera, CameraModel, FovAxis};
+use tessera::color::Rgb;
 use tessera::error::{Error, Result};
 use tessera::geometry::{Frame, Ray, offset_ray_origin, shapes};
 use tessera::image::{Bitmap, ColorSpace, read_bitmap};
@@ -90,8 +93,8 @@ pub enum Suite {
     Render,
     /// Texture lookups: bitmap, classical and deformed tiling and blending.
     Textures,
-    /// Shading arithmetic in SIMD lanes: GGX visible-normal sampling one at a time and eight at
-    /// a time, portable and AVX2.
+    /// Shading arithmetic in SIMD lanes: scene A's conductor one path at a time and eight at a
+    /// time, portable and AVX2.
     Lanes,
     /// `tessera deform` on a mesh of 262k triangles.
     Deform,
@@ -335,22 +338,31 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
     Ok(())
 }
 
-/// Scene A's conductor (alpha 0.05 x 0.3) sampling visible normals for 1M directions over the
-/// upper hemisphere: one at a time, as the path tracer calls it, and eight at a time in lanes
-/// with each instruction set this CPU has.
+/// Scene A's aluminium (alpha 0.05 x 0.3) at 1M directions wo over the upper hemisphere, one
+/// at a time as the path tracer calls it and eight at a time in lanes with each instruction set
+/// this CPU has: GGX's visible-normal sampling alone, and what a path's vertex asks of the
+/// conductor (a sample, with its colour, and f and the density at a light's direction).
 fn lanes(runs: usize) {
     let ggx = Ggx::new(0.05, 0.3);
+    let (eta, k) = tessera::material::named_conductor("Al").expect("a named conductor");
+    let conductor =
+        Conductor { ggx: Some(ggx), fresnel: ConductorFresnel::Complex { eta, k }, specular_reflectance: Rgb::ONE };
     let n = 1 << 20;
     let mut sampler = Sampler::new(3, 0, 0);
-    let inputs: Vec<(Vec3, Vec2)> =
-        (0..n).map(|_| (warp::square_to_cosine_hemisphere(sampler.next_2d()), sampler.next_2d())).collect();
-    let lanes: Vec<(V3<F32x8>, [F32x8; 2])> = inputs
+    let mut direction = || warp::square_to_cosine_hemisphere(sampler.next_2d());
+    let inputs: Vec<[Vec3; 3]> = (0..n).map(|_| [direction(), direction(), direction()]).collect();
+    let lanes: Vec<[V3<F32x8>; 3]> = inputs
         .chunks_exact(8)
         .map(|c| {
-            let w = V3::new(F32x8::from_fn(|i| c[i].0.x), F32x8::from_fn(|i| c[i].0.y), F32x8::from_fn(|i| c[i].0.z));
-            (w, [F32x8::from_fn(|i| c[i].1.x), F32x8::from_fn(|i| c[i].1.y)])
+            std::array::from_fn(|j| {
+                V3::new(F32x8::from_fn(|i| c[i][j].x), F32x8::from_fn(|i| c[i][j].y), F32x8::from_fn(|i| c[i][j].z))
+            })
         })
         .collect();
+    // The sample numbers are the third direction's x and y, mapped to [0, 1).
+    let u = |w: Vec3| Vec2::new(0.5 + 0.5 * w.x, 0.5 + 0.5 * w.y);
+    let u_lanes =
+        |w: V3<F32x8>| [F32x8::splat(0.5) + F32x8::splat(0.5) * w.x, F32x8::splat(0.5) + F32x8::splat(0.5) * w.y];
     let rate = |f: &dyn Fn() -> f32| {
         median(
             (0..runs)
@@ -362,25 +374,75 @@ fn lanes(runs: usize) {
                 .collect(),
         )
     };
-    let scalar = rate(&|| inputs.iter().map(|&(w, u)| ggx.sample_visible(std::hint::black_box(w), u).z).sum());
-    println!("lanes      GGX visible normals (alpha 0.05 x 0.3), {n} samples on 1 thread:");
-    println!("           one at a time (f32)          {scalar:7.1} M samples/s  (1.00x)");
-    for isa in [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available()) {
-        let lanes = rate(&|| {
-            isa.run(|| {
-                let mut sum = F32x8::splat(0.0);
-                for &(w, u) in std::hint::black_box(&lanes) {
-                    sum = sum + ggx.sample_visible_of(w, u).z;
-                }
-                sum.0.iter().sum()
+    let isas: Vec<Isa> = [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available()).collect();
+    let print = |name: &str, scalar: f64, lanes: &[f64]| {
+        println!("           {name:<38} one at a time {scalar:6.1} M/s, eight lanes:");
+        for (isa, rate) in isas.iter().zip(lanes) {
+            println!("           {:<38}   {:<8} {rate:6.1} M/s ({:.2}x)", "", format!("{isa:?}"), rate / scalar);
+        }
+    };
+    println!("lanes      scene A's aluminium (alpha 0.05 x 0.3), {n} directions on 1 thread:");
+
+    let scalar = rate(&|| inputs.iter().map(|&[wo, _, w]| ggx.sample_visible(std::hint::black_box(wo), u(w)).z).sum());
+    let lanes_rates: Vec<f64> = isas
+        .iter()
+        .map(|isa| {
+            rate(&|| {
+                isa.run(|| {
+                    let mut sum = F32x8::splat(0.0);
+                    for &[wo, _, w] in std::hint::black_box(&lanes) {
+                        sum = sum + ggx.sample_visible_of(wo, u_lanes(w)).z;
+                    }
+                    sum.0.iter().sum()
+                })
             })
-        });
-        println!(
-            "           eight lanes, {:<16} {lanes:7.1} M samples/s  ({:.2}x)",
-            format!("{isa:?}"),
-            lanes / scalar
-        );
-    }
+        })
+        .collect();
+    print("GGX visible-normal sampling", scalar, &lanes_rates);
+
+    let scalar = rate(&|| {
+        inputs
+            .iter()
+            .map(|&[wo, wl, w]| {
+                let wo = std::hint::black_box(wo);
+                let weight = conductor.sample(wo, u(w)).map_or(0.0, |s| s.weight.element_sum() + s.pdf);
+                let (f, pdf) = conductor.eval_pdf(wo, wl);
+                weight + f.element_sum() + pdf
+            })
+            .sum()
+    });
+    let lanes_rates: Vec<f64> = isas
+        .iter()
+        .map(|isa| {
+            rate(&|| {
+                isa.run(|| {
+                    let zero = F32x8::splat(0.0);
+                    // F channel by channel, written out: a call that stays out of line is
+                    // compiled without AVX2 (src/simd/lanes.rs).
+                    let channels =
+                        [(eta.x, k.x), (eta.y, k.y), (eta.z, k.z)].map(|(e, k)| (F32x8::splat(e), F32x8::splat(k)));
+                    let [(eta_r, k_r), (eta_g, k_g), (eta_b, k_b)] = channels;
+                    let colour_sum = |cos: F32x8| {
+                        fresnel_conductor_of(cos, eta_r, k_r)
+                            + fresnel_conductor_of(cos, eta_g, k_g)
+                            + fresnel_conductor_of(cos, eta_b, k_b)
+                    };
+                    let mut sum = zero;
+                    for &[wo, wl, w] in std::hint::black_box(&lanes) {
+                        let sample = Conductor::sample_terms(&ggx, wo, u_lanes(w));
+                        let weight = colour_sum(sample.cos_m) * sample.factor;
+                        let eval = Conductor::eval_terms(&ggx, wo, wl);
+                        let f = colour_sum(eval.cos_m) * eval.factor;
+                        sum = sum
+                            + F32x8::select(sample.valid, weight + sample.pdf, zero)
+                            + F32x8::select(eval.valid, f + eval.pdf, zero);
+                    }
+                    sum.0.iter().sum()
+                })
+            })
+        })
+        .collect();
+    print("conductor sample + eval_pdf, with F", scalar, &lanes_rates);
 }
 
 fn deform(runs: usize) -> Result<()> {

@@ -7,7 +7,7 @@
 //! returned, bit for bit. Eight lanes compile to AVX2 where the CPU has it and to SSE2 (two
 //! halves) where not ([`Isa`]); both run the same IEEE operations in the same order, so they
 //! agree bit for bit. Lanes differ from `f32` only in [`Real::sin_cos`]: libm's for `f32`, a
-//! polynomial in lanes ([`trig`]).
+//! polynomial in lanes ([`trig`]). An RGB colour is a [`Real`] too, its channels being lanes.
 
 mod dispatch;
 mod lanes;
@@ -34,7 +34,8 @@ pub trait Real:
     fn splat(x: f32) -> Self;
     /// Square root (IEEE, correctly rounded).
     fn sqrt(self) -> Self;
-    /// `f32::max` in every lane: the other operand where one is NaN.
+    /// The larger of the two in every lane; `other` where `self` is NaN (callers pass a
+    /// number as `other`).
     fn max(self, other: Self) -> Self;
     /// `self < other`, per lane (false for NaN).
     fn lt(self, other: Self) -> Self::Mask;
@@ -83,6 +84,48 @@ impl Real for f32 {
         f32::sin_cos(self)
     }
 }
+
+/// An RGB colour's three channels as three lanes (one SSE register: glam's `Vec3A`, which
+/// [`crate::color::Rgb`] is), so that a colour's arithmetic, such as a Fresnel term, is written
+/// once over [`Real`] for one path's colour and, channel by channel, for eight paths'.
+impl Real for glam::Vec3A {
+    type Mask = glam::BVec3A;
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        glam::Vec3A::splat(x)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        glam::Vec3A::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        glam::Vec3A::max(self, other)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> glam::BVec3A {
+        self.cmplt(other)
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> glam::BVec3A {
+        self.cmple(other)
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> glam::BVec3A {
+        self.cmpeq(other)
+    }
+    #[inline(always)]
+    fn select(mask: glam::BVec3A, a: Self, b: Self) -> Self {
+        glam::Vec3A::select(mask, a, b)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let ((sx, cx), (sy, cy), (sz, cz)) = (self.x.sin_cos(), self.y.sin_cos(), self.z.sin_cos());
+        (glam::Vec3A::new(sx, sy, sz), glam::Vec3A::new(cx, cy, cz))
+    }
+}
+
+impl Mask for glam::BVec3A {}
 
 /// A 3-vector of [`Real`]s, with glam's `Vec3` operations in glam's order of operations, so
 /// that `V3<f32>` computes what `Vec3` computes bit for bit.
@@ -133,6 +176,14 @@ impl<T: Real> Add for V3<T> {
     #[inline(always)]
     fn add(self, o: Self) -> Self {
         V3::new(self.x + o.x, self.y + o.y, self.z + o.z)
+    }
+}
+
+impl<T: Real> Sub for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        V3::new(self.x - o.x, self.y - o.y, self.z - o.z)
     }
 }
 

@@ -1,10 +1,12 @@
 //! Sine and cosine in lanes, where libm cannot run: Cody and Waite's reduction by pi/2 (pi/2
 //! split in three parts, so that q pi/2 is subtracted without rounding for |q| < 2^13) and the
 //! minimax polynomials of Cephes' `sinf` and `cosf` on [-pi/4, pi/4] (Moshier 1989). Within 2e-7
-//! of the true values for |x| <= 8192 (tested); the path tracer calls it on [0, 2 pi).
+//! of the true values for |x| <= 8192 (tested); the path tracer calls it on [0, 2 pi). Its loops
+//! index the lanes, as `lanes.rs` explains.
+#![allow(clippy::needless_range_loop)]
 
 use super::Real;
-use super::lanes::F32x8;
+use super::lanes::{F32x8, M32x8};
 
 /// pi/2 in three parts: the first two have few enough bits that q times them is exact.
 const PI_2_PARTS: [f32; 3] = [1.570_312_5, 4.837_513e-4, 7.549_79e-8];
@@ -24,12 +26,19 @@ pub fn sin_cos(x: F32x8) -> (F32x8, F32x8) {
     // x = q pi/2 + r: odd quadrants swap sine and cosine; quadrants 2 and 3 negate the sine,
     // quadrants 1 and 2 the cosine (by the sign bit).
     let q = q.to_i32();
-    let swap = super::M32x8(q.map(|q| 0u32.wrapping_sub((q & 1) as u32)));
-    let sin_sign = q.map(|q| ((q & 2) as u32) << 30);
-    let cos_sign = q.map(|q| ((q.wrapping_add(1) & 2) as u32) << 30);
-    let (sin, cos) = (F32x8::select(swap, cos_r, sin_r).to_bits(), F32x8::select(swap, sin_r, cos_r).to_bits());
-    let sin_out = std::array::from_fn(|i| sin[i] ^ sin_sign[i]);
-    let cos_out = std::array::from_fn(|i| cos[i] ^ cos_sign[i]);
+    let (mut swap, mut sin_sign, mut cos_sign) = ([0u32; 8], [0u32; 8], [0u32; 8]);
+    for i in 0..8 {
+        swap[i] = 0u32.wrapping_sub((q[i] & 1) as u32);
+        sin_sign[i] = ((q[i] & 2) as u32) << 30;
+        cos_sign[i] = ((q[i].wrapping_add(1) & 2) as u32) << 30;
+    }
+    let (sin, cos) =
+        (F32x8::select(M32x8(swap), cos_r, sin_r).to_bits(), F32x8::select(M32x8(swap), sin_r, cos_r).to_bits());
+    let (mut sin_out, mut cos_out) = ([0u32; 8], [0u32; 8]);
+    for i in 0..8 {
+        sin_out[i] = sin[i] ^ sin_sign[i];
+        cos_out[i] = cos[i] ^ cos_sign[i];
+    }
     (F32x8::from_bits(sin_out), F32x8::from_bits(cos_out))
 }
 
