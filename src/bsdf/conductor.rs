@@ -136,37 +136,19 @@ pub struct ReflectionTerms<T: Real> {
 mod tests {
     use super::*;
     use crate::bsdf::fresnel::fresnel_conductor_of;
-    use crate::simd::{F32x8, Isa};
-
-    /// Directions over the sphere, with the poles and the horizon.
-    fn direction(k: usize) -> Vec3 {
-        match k % 89 {
-            0 => Vec3::Z,
-            1 => Vec3::X,
-            2 => -Vec3::Z,
-            _ => {
-                let u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.414_213_57).fract());
-                crate::sampling::warp::square_to_uniform_sphere(u)
-            }
-        }
-    }
-
-    fn lanes(f: impl Fn(usize) -> Vec3) -> V3<F32x8> {
-        V3::new(F32x8::from_fn(|i| f(i).x), F32x8::from_fn(|i| f(i).y), F32x8::from_fn(|i| f(i).z))
-    }
-
-    const ISAS: [Isa; 2] = [Isa::Portable, Isa::Avx2];
+    use crate::simd::F32x8;
+    use crate::simd::testing::{direction, gather, isas, lane, numbers, upper_direction};
 
     #[test]
     fn lanes_evaluate_and_fresnel_bit_for_bit_as_one_path_does() {
         let ggx = Ggx::new(0.05, 0.3);
         let (eta, k) = (Rgb::new(1.657_5, 0.880_3, 0.521_2), Rgb::new(9.223_8, 6.269_5, 4.837));
-        for isa in ISAS.into_iter().filter(|isa| isa.available()) {
+        for isa in isas() {
             for chunk in 0..2000 {
                 let (wo, wi) = (|i| direction(chunk * 16 + i), |i| direction(chunk * 16 + 8 + i));
                 let cos = F32x8::from_fn(|i| (chunk * 8 + i) as f32 / 16_000.0);
                 let (terms, fresnel) = isa.run(|| {
-                    let terms = Conductor::eval_terms(&ggx, lanes(wo), lanes(wi));
+                    let terms = Conductor::eval_terms(&ggx, gather(wo), gather(wi));
                     let channel = |c: usize| fresnel_conductor_of(cos, F32x8::splat(eta[c]), F32x8::splat(k[c]));
                     (terms, [channel(0), channel(1), channel(2)])
                 });
@@ -194,20 +176,21 @@ mod tests {
         let ggx = Ggx::new(0.05, 0.3);
         let mut worst = 0.0f32;
         let mut by_isa = Vec::new();
-        for isa in ISAS.into_iter().filter(|isa| isa.available()) {
+        for isa in isas() {
             let mut bits = Vec::new();
             for chunk in 0..4000 {
-                let wo = |i: usize| {
-                    let w = direction(chunk * 8 + i);
-                    Vec3::new(w.x, w.y, w.z.abs().max(1e-3)).normalize()
-                };
-                let u = |i: usize| [((chunk * 8 + i) as f32 * 0.754_877_7).fract(), (i as f32 + 0.5) / 8.0];
+                let wo = |i: usize| upper_direction(chunk * 8 + i);
+                let u = |i: usize| numbers(chunk, i);
                 let terms = isa.run(|| {
-                    Conductor::sample_terms(&ggx, lanes(wo), [F32x8::from_fn(|i| u(i)[0]), F32x8::from_fn(|i| u(i)[1])])
+                    Conductor::sample_terms(
+                        &ggx,
+                        gather(wo),
+                        [F32x8::from_fn(|i| u(i)[0]), F32x8::from_fn(|i| u(i)[1])],
+                    )
                 });
                 for i in 0..8 {
                     let one = Conductor::sample_terms(&ggx, wo(i).into(), u(i));
-                    let wi = Vec3::new(terms.wi.x.0[i], terms.wi.y.0[i], terms.wi.z.0[i]);
+                    let wi = lane(terms.wi, i);
                     // Away from the horizon, where the sine's last bits cannot decide validity.
                     if one.wi.z.abs() > 1e-3 {
                         assert_eq!(terms.valid.test(i), one.valid, "{isa:?} wo {} u {:?}", wo(i), u(i));

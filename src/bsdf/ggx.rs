@@ -112,7 +112,8 @@ impl Ggx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::simd::{F32x8, Isa};
+    use crate::simd::F32x8;
+    use crate::simd::testing::{direction, gather, isas, lane, numbers, upper_direction};
 
     /// Integrate f over the sphere with a midpoint rule in (cos theta, phi).
     fn integrate_sphere(f: impl Fn(Vec3) -> f64, n: usize) -> f64 {
@@ -149,32 +150,13 @@ mod tests {
         }
     }
 
-    /// Eight lanes from `f(i)` (i the lane).
-    fn lanes(f: impl Fn(usize) -> Vec3) -> V3<F32x8> {
-        V3::new(F32x8::from_fn(|i| f(i).x), F32x8::from_fn(|i| f(i).y), F32x8::from_fn(|i| f(i).z))
-    }
-
-    /// Directions over the sphere (and on its poles and equator, where the formulas branch).
-    fn direction(k: usize) -> Vec3 {
-        match k % 97 {
-            0 => Vec3::Z,
-            1 => Vec3::X,
-            2 => -Vec3::Z,
-            3 => Vec3::new(0.0, 1e-20, 1.0),
-            _ => {
-                let u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.414_213_57).fract());
-                crate::sampling::warp::square_to_uniform_sphere(u)
-            }
-        }
-    }
-
     #[test]
     fn lanes_give_d_and_g1_bit_for_bit_with_either_instruction_set() {
         let g = Ggx::new(0.05, 0.3);
-        for isa in [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available()) {
+        for isa in isas() {
             for chunk in 0..2000 {
                 let (v, m) = (|i| direction(chunk * 16 + i), |i| direction(chunk * 16 + 8 + i));
-                let (d, g1) = isa.run(|| (g.d_of(lanes(m)), g.g1_of(lanes(v), lanes(m))));
+                let (d, g1) = isa.run(|| (g.d_of(gather(m)), g.g1_of(gather(v), gather(m))));
                 for i in 0..8 {
                     assert_eq!(d.0[i].to_bits(), g.d(m(i)).to_bits(), "{isa:?} D({})", m(i));
                     assert_eq!(g1.0[i].to_bits(), g.g1(v(i), m(i)).to_bits(), "{isa:?} G1({}, {})", v(i), m(i));
@@ -188,18 +170,15 @@ mod tests {
         let g = Ggx::new(0.05, 0.3);
         let mut worst = 0.0f32;
         let mut by_isa = Vec::new();
-        for isa in [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available()) {
+        for isa in isas() {
             let mut samples = Vec::new();
             for chunk in 0..4000 {
-                let w = |i: usize| {
-                    let w = direction(chunk * 8 + i);
-                    Vec3::new(w.x, w.y, w.z.abs().max(1e-3)).normalize()
-                };
-                let u = |i: usize| Vec2::new(((chunk * 8 + i) as f32 * 0.754_877_7).fract(), (i as f32 + 0.5) / 8.0);
-                let m =
-                    isa.run(|| g.sample_visible_of(lanes(w), [F32x8::from_fn(|i| u(i).x), F32x8::from_fn(|i| u(i).y)]));
+                let w = |i: usize| upper_direction(chunk * 8 + i);
+                let u = |i: usize| Vec2::from(numbers(chunk, i));
+                let m = isa
+                    .run(|| g.sample_visible_of(gather(w), [F32x8::from_fn(|i| u(i).x), F32x8::from_fn(|i| u(i).y)]));
                 for i in 0..8 {
-                    let lane = Vec3::new(m.x.0[i], m.y.0[i], m.z.0[i]);
+                    let lane = lane(m, i);
                     worst = worst.max((lane - g.sample_visible(w(i), u(i))).abs().max_element());
                     samples.push(lane.to_array().map(f32::to_bits));
                 }

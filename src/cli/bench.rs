@@ -7,8 +7,8 @@
 //! - A full render of `scenes/brushed_metal.toml` (Mitsuba scene A: 512 x 512, 64 spp, max
 //!   depth 8): samples per second, against Mitsuba 3's figures measured on this kind of machine.
 //! - Shading arithmetic in SIMD lanes (issue 19): scene A's aluminium at 1M directions, GGX
-//!   visible-normal sampling alone and the conductor's sample and evaluation with their Fresnel
-//!   colours, one at a time as the path tracer calls them and eight at a time in lanes
+//!   visible-normal sampling alone, the conductor's sample and evaluation with their Fresnel
+//!   colours, and the diffuse BSDF's, one at a time as the path tracer calls them and eight at a time in lanes
 //!   (portable, and AVX2 where the CPU has it), on one thread, as ratios to the first.
 //! - `tessera deform`'s computation (deformation gradients, polar decompositions, orientation,
 //!   a 256 x 256 smoothing grid, a 1024 x 1024 F map) on a lat-long UV sphere of 262k
@@ -39,7 +39,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use tessera::accel::{Accel, AccelKind};
 use tessera::bsdf::fresnel::fresnel_conductor_of;
-use tessera::bsdf::{Conductor, ConductorFresnel, Ggx};
+use tessera::bsdf::{Conductor, ConductorFresnel, Diffuse, Ggx};
 use tessera::camera::{Camera, CameraModel, FovAxis};
 use tessera::color::Rgb;
 use tessera::error::{Error, Result};
@@ -341,7 +341,8 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
 /// Scene A's aluminium (alpha 0.05 x 0.3) at 1M directions wo over the upper hemisphere, one
 /// at a time as the path tracer calls it and eight at a time in lanes with each instruction set
 /// this CPU has: GGX's visible-normal sampling alone, and what a path's vertex asks of the
-/// conductor (a sample, with its colour, and f and the density at a light's direction).
+/// conductor and of the floor's diffuse BSDF (a sample, with its colour, and f and the density
+/// at a light's direction).
 fn lanes(runs: usize) {
     let ggx = Ggx::new(0.05, 0.3);
     let (eta, k) = tessera::material::named_conductor("Al").expect("a named conductor");
@@ -363,86 +364,99 @@ fn lanes(runs: usize) {
     let u = |w: Vec3| Vec2::new(0.5 + 0.5 * w.x, 0.5 + 0.5 * w.y);
     let u_lanes =
         |w: V3<F32x8>| [F32x8::splat(0.5) + F32x8::splat(0.5) * w.x, F32x8::splat(0.5) + F32x8::splat(0.5) * w.y];
-    let rate = |f: &dyn Fn() -> f32| {
-        median(
-            (0..runs)
-                .map(|_| {
-                    let start = Instant::now();
-                    std::hint::black_box(f());
-                    n as f64 / start.elapsed().as_secs_f64() / 1e6
-                })
-                .collect(),
-        )
-    };
     let isas: Vec<Isa> = [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available()).collect();
-    let print = |name: &str, scalar: f64, lanes: &[f64]| {
+    println!(
+        "lanes      scene A's BSDFs (aluminium, alpha 0.05 x 0.3; the floor's diffuse), {n} directions on 1 thread:"
+    );
+    let figures = |name: &str, scalar: f64, lane_rate: &dyn Fn(Isa) -> f64| {
         println!("           {name:<38} one at a time {scalar:6.1} M/s, eight lanes:");
-        for (isa, rate) in isas.iter().zip(lanes) {
+        for isa in &isas {
+            let rate = lane_rate(*isa);
             println!("           {:<38}   {:<8} {rate:6.1} M/s ({:.2}x)", "", format!("{isa:?}"), rate / scalar);
         }
     };
-    println!("lanes      scene A's aluminium (alpha 0.05 x 0.3), {n} directions on 1 thread:");
-
-    let scalar = rate(&|| inputs.iter().map(|&[wo, _, w]| ggx.sample_visible(std::hint::black_box(wo), u(w)).z).sum());
-    let lanes_rates: Vec<f64> = isas
-        .iter()
-        .map(|isa| {
-            rate(&|| {
-                isa.run(|| {
-                    let mut sum = F32x8::splat(0.0);
-                    for &[wo, _, w] in std::hint::black_box(&lanes) {
-                        sum = sum + ggx.sample_visible_of(wo, u_lanes(w)).z;
-                    }
-                    sum.0.iter().sum()
-                })
-            })
-        })
-        .collect();
-    print("GGX visible-normal sampling", scalar, &lanes_rates);
-
-    let scalar = rate(&|| {
+    // Each kernel reads (wo, a light's direction, a direction whose x and y give the sample
+    // numbers) and returns a sum of what it computed, so that none of it is optimised away. The
+    // kernels are passed by type, not as `dyn Fn`, so that they inline: into the loop one at a
+    // time, and into the AVX2 function in lanes (src/simd/lanes.rs).
+    let scalar = |kernel: &dyn Fn(&[[Vec3; 3]]) -> f32| rate(runs, n, &|| kernel(std::hint::black_box(&inputs)));
+    let one = scalar(&|inputs| inputs.iter().map(|&[wo, _, w]| ggx.sample_visible(wo, u(w)).z).sum());
+    figures("GGX visible-normal sampling", one, &|isa| {
+        rate(runs, n, &|| lane_sum(isa, &lanes, |[wo, _, w]| ggx.sample_visible_of(wo, u_lanes(w)).z))
+    });
+    let (eta, k) = (eta.to_array().map(F32x8::splat), k.to_array().map(F32x8::splat));
+    let one = scalar(&|inputs| {
         inputs
             .iter()
             .map(|&[wo, wl, w]| {
-                let wo = std::hint::black_box(wo);
                 let weight = conductor.sample(wo, u(w)).map_or(0.0, |s| s.weight.element_sum() + s.pdf);
                 let (f, pdf) = conductor.eval_pdf(wo, wl);
                 weight + f.element_sum() + pdf
             })
             .sum()
     });
-    let lanes_rates: Vec<f64> = isas
-        .iter()
-        .map(|isa| {
-            rate(&|| {
-                isa.run(|| {
-                    let zero = F32x8::splat(0.0);
-                    // F channel by channel, written out: a call that stays out of line is
-                    // compiled without AVX2 (src/simd/lanes.rs).
-                    let channels =
-                        [(eta.x, k.x), (eta.y, k.y), (eta.z, k.z)].map(|(e, k)| (F32x8::splat(e), F32x8::splat(k)));
-                    let [(eta_r, k_r), (eta_g, k_g), (eta_b, k_b)] = channels;
-                    let colour_sum = |cos: F32x8| {
-                        fresnel_conductor_of(cos, eta_r, k_r)
-                            + fresnel_conductor_of(cos, eta_g, k_g)
-                            + fresnel_conductor_of(cos, eta_b, k_b)
-                    };
-                    let mut sum = zero;
-                    for &[wo, wl, w] in std::hint::black_box(&lanes) {
-                        let sample = Conductor::sample_terms(&ggx, wo, u_lanes(w));
-                        let weight = colour_sum(sample.cos_m) * sample.factor;
-                        let eval = Conductor::eval_terms(&ggx, wo, wl);
-                        let f = colour_sum(eval.cos_m) * eval.factor;
-                        sum = sum
-                            + F32x8::select(sample.valid, weight + sample.pdf, zero)
-                            + F32x8::select(eval.valid, f + eval.pdf, zero);
-                    }
-                    sum.0.iter().sum()
-                })
+    figures("conductor sample + eval_pdf, with F", one, &|isa| {
+        rate(runs, n, &|| {
+            lane_sum(isa, &lanes, |[wo, wl, w]| {
+                let zero = F32x8::splat(0.0);
+                let colour_sum = |cos: F32x8| {
+                    fresnel_conductor_of(cos, eta[0], k[0])
+                        + fresnel_conductor_of(cos, eta[1], k[1])
+                        + fresnel_conductor_of(cos, eta[2], k[2])
+                };
+                let sample = Conductor::sample_terms(&ggx, wo, u_lanes(w));
+                let eval = Conductor::eval_terms(&ggx, wo, wl);
+                F32x8::select(sample.valid, colour_sum(sample.cos_m) * sample.factor + sample.pdf, zero)
+                    + F32x8::select(eval.valid, colour_sum(eval.cos_m) * eval.factor + eval.pdf, zero)
             })
         })
-        .collect();
-    print("conductor sample + eval_pdf, with F", scalar, &lanes_rates);
+    });
+    let diffuse = Diffuse { reflectance: Rgb::new(0.8, 0.6, 0.4) };
+    let albedo = F32x8::splat(diffuse.reflectance.element_sum());
+    let one = scalar(&|inputs| {
+        inputs
+            .iter()
+            .map(|&[wo, wl, w]| {
+                let weight = diffuse.sample(wo, u(w)).map_or(0.0, |s| s.weight.element_sum() + s.wi.z + s.pdf);
+                let (f, pdf) = diffuse.eval_pdf(wo, wl);
+                weight + f.element_sum() + pdf
+            })
+            .sum()
+    });
+    figures("diffuse sample + eval_pdf", one, &|isa| {
+        rate(runs, n, &|| {
+            lane_sum(isa, &lanes, |[wo, wl, w]| {
+                let zero = F32x8::splat(0.0);
+                let (wi, pdf, valid) = Diffuse::sample_terms(wo, u_lanes(w));
+                let (factor, eval_pdf, lit) = Diffuse::eval_terms(wo, wl);
+                F32x8::select(valid, albedo + wi.z + pdf, zero) + F32x8::select(lit, albedo * factor + eval_pdf, zero)
+            })
+        })
+    });
+}
+
+/// Millions of items per second of `f` over `n` items, median of `runs`.
+fn rate(runs: usize, n: usize, f: &dyn Fn() -> f32) -> f64 {
+    median(
+        (0..runs)
+            .map(|_| {
+                let start = Instant::now();
+                std::hint::black_box(f());
+                n as f64 / start.elapsed().as_secs_f64() / 1e6
+            })
+            .collect(),
+    )
+}
+
+/// The sum of `kernel` over `inputs`, eight at a time with the instruction set `isa`.
+fn lane_sum(isa: Isa, inputs: &[[V3<F32x8>; 3]], kernel: impl Fn([V3<F32x8>; 3]) -> F32x8) -> f32 {
+    isa.run(|| {
+        let mut sum = F32x8::splat(0.0);
+        for &x in std::hint::black_box(inputs) {
+            sum = sum + kernel(x);
+        }
+        sum.0.iter().sum()
+    })
 }
 
 fn deform(runs: usize) -> Result<()> {

@@ -1,33 +1,55 @@
 //! Warps from the unit square to directions and points, with their densities.
 
+use crate::simd::{Real, V3};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
 /// Shirley-Chiu concentric map of the unit square to the unit disk (area-preserving).
 #[inline]
 pub fn square_to_uniform_disk_concentric(u: Vec2) -> Vec2 {
-    let p = 2.0 * u - Vec2::ONE;
-    if p.x == 0.0 && p.y == 0.0 {
-        return Vec2::ZERO;
-    }
-    let (r, theta) =
-        if p.x.abs() > p.y.abs() { (p.x, FRAC_PI_4 * (p.y / p.x)) } else { (p.y, FRAC_PI_2 - FRAC_PI_4 * (p.x / p.y)) };
+    let (x, y) = square_to_uniform_disk_concentric_of([u.x, u.y]);
+    Vec2::new(x, y)
+}
+
+/// [`square_to_uniform_disk_concentric`] in one lane or eight.
+#[inline(always)]
+pub fn square_to_uniform_disk_concentric_of<T: Real>(u: [T; 2]) -> (T, T) {
+    let (one, zero) = (T::splat(1.0), T::splat(0.0));
+    let p = (T::splat(2.0) * u[0] - one, T::splat(2.0) * u[1] - one);
+    let wide = p.1.abs().lt(p.0.abs());
+    let r = T::select(wide, p.0, p.1);
+    let theta =
+        T::select(wide, T::splat(FRAC_PI_4) * (p.1 / p.0), T::splat(FRAC_PI_2) - T::splat(FRAC_PI_4) * (p.0 / p.1));
     let (s, c) = theta.sin_cos();
-    Vec2::new(r * c, r * s)
+    // The centre maps to itself (where theta is 0 / 0).
+    let centre = p.0.eq(zero) & p.1.eq(zero);
+    (T::select(centre, zero, r * c), T::select(centre, zero, r * s))
 }
 
 /// Cosine-weighted hemisphere around +z (Malley's method on the concentric disk).
 #[inline]
 pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = square_to_uniform_disk_concentric(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    square_to_cosine_hemisphere_of([u.x, u.y]).into()
+}
+
+/// [`square_to_cosine_hemisphere`] in one lane or eight.
+#[inline(always)]
+pub fn square_to_cosine_hemisphere_of<T: Real>(u: [T; 2]) -> V3<T> {
+    let (x, y) = square_to_uniform_disk_concentric_of(u);
+    let z = (T::splat(1.0) - (x * x + y * y)).max(T::splat(0.0)).sqrt();
+    V3::new(x, y, z)
 }
 
 /// Density of [`square_to_cosine_hemisphere`] (per steradian).
 #[inline]
 pub fn cosine_hemisphere_pdf(w: Vec3) -> f32 {
-    if w.z > 0.0 { w.z * FRAC_1_PI } else { 0.0 }
+    cosine_hemisphere_pdf_of(w.z)
+}
+
+/// [`cosine_hemisphere_pdf`] in one lane or eight, of a direction's z.
+#[inline(always)]
+pub fn cosine_hemisphere_pdf_of<T: Real>(z: T) -> T {
+    T::select(T::splat(0.0).lt(z), z * T::splat(FRAC_1_PI), T::splat(0.0))
 }
 
 /// Uniform direction on the unit sphere.

@@ -170,6 +170,10 @@ impl Real for F32x8 {
         self.map(f32::sqrt)
     }
     #[inline(always)]
+    fn abs(self) -> Self {
+        self.map(f32::abs)
+    }
+    #[inline(always)]
     fn max(self, other: Self) -> Self {
         self.zip(other, f32::max)
     }

@@ -34,6 +34,8 @@ pub trait Real:
     fn splat(x: f32) -> Self;
     /// Square root (IEEE, correctly rounded).
     fn sqrt(self) -> Self;
+    /// Absolute value (the sign bit cleared).
+    fn abs(self) -> Self;
     /// The larger of the two in every lane; `other` where `self` is NaN (callers pass a
     /// number as `other`).
     fn max(self, other: Self) -> Self;
@@ -58,6 +60,10 @@ impl Real for f32 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
@@ -97,6 +103,10 @@ impl Real for glam::Vec3A {
     #[inline(always)]
     fn sqrt(self) -> Self {
         glam::Vec3A::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        glam::Vec3A::abs(self)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
@@ -214,5 +224,53 @@ impl From<V3<f32>> for glam::Vec3 {
     #[inline(always)]
     fn from(v: V3<f32>) -> Self {
         glam::Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+/// What the lane tests of the BSDFs share.
+#[cfg(test)]
+pub(crate) mod testing {
+    use super::{F32x8, Isa, V3};
+    use glam::{Vec2, Vec3};
+
+    /// Eight lanes from `f(i)`, i the lane.
+    pub fn gather(f: impl Fn(usize) -> Vec3) -> V3<F32x8> {
+        V3::new(F32x8::from_fn(|i| f(i).x), F32x8::from_fn(|i| f(i).y), F32x8::from_fn(|i| f(i).z))
+    }
+
+    /// Lane `i` of `v`.
+    pub fn lane(v: V3<F32x8>, i: usize) -> Vec3 {
+        Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i])
+    }
+
+    /// Directions over the sphere, and the poles, the horizon and a direction a hair off the
+    /// pole, where the formulas branch.
+    pub fn direction(k: usize) -> Vec3 {
+        match k % 97 {
+            0 => Vec3::Z,
+            1 => Vec3::X,
+            2 => -Vec3::Z,
+            3 => Vec3::new(0.0, 1e-20, 1.0),
+            _ => {
+                let u = Vec2::new((k as f32 * 0.618_034).fract(), (k as f32 * 0.414_213_57).fract());
+                crate::sampling::warp::square_to_uniform_sphere(u)
+            }
+        }
+    }
+
+    /// [`direction`] moved into the upper hemisphere (z at least 1e-3).
+    pub fn upper_direction(k: usize) -> Vec3 {
+        let w = direction(k);
+        Vec3::new(w.x, w.y, w.z.abs().max(1e-3)).normalize()
+    }
+
+    /// Sample numbers in [0, 1)^2 for lane `i` of chunk `chunk`.
+    pub fn numbers(chunk: usize, i: usize) -> [f32; 2] {
+        [((chunk * 8 + i) as f32 * 0.754_877_7).fract(), (i as f32 + 0.5) / 8.0]
+    }
+
+    /// The instruction sets this CPU runs.
+    pub fn isas() -> impl Iterator<Item = Isa> {
+        [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available())
     }
 }
