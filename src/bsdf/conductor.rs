@@ -110,9 +110,9 @@ impl Conductor {
         let d = ggx.d_of(m);
         let g1_o = ggx.g1_of(wo, m);
         let g = g1_o * ggx.g1_of(wi, m);
-        let quarter = T::splat(4.0) * wo.z;
+        let four_wo_z = T::splat(4.0) * wo.z;
         let valid = !wo.z.le(zero) & !wi.z.le(zero) & !d.eq(zero);
-        ReflectionTerms { wi, cos_m: wo.dot(m), factor: d * g / quarter, pdf: d * g1_o / quarter, valid }
+        ReflectionTerms { wi, cos_m: wo.dot(m), factor: d * g / four_wo_z, pdf: d * g1_o / four_wo_z, valid }
     }
 }
 
@@ -154,9 +154,9 @@ mod tests {
                 });
                 for i in 0..8 {
                     let one = Conductor::eval_terms(&ggx, wo(i).into(), wi(i).into());
-                    let lane = (terms.valid.test(i), terms.cos_m.0[i], terms.factor.0[i], terms.pdf.0[i]);
+                    let got = (terms.valid.test(i), terms.cos_m.0[i], terms.factor.0[i], terms.pdf.0[i]);
                     assert_eq!(
-                        (lane.0, lane.1.to_bits(), lane.2.to_bits(), lane.3.to_bits()),
+                        (got.0, got.1.to_bits(), got.2.to_bits(), got.3.to_bits()),
                         (one.valid, one.cos_m.to_bits(), one.factor.to_bits(), one.pdf.to_bits()),
                         "{isa:?} wo {} wi {}",
                         wo(i),

@@ -178,9 +178,9 @@ mod tests {
                 let m = isa
                     .run(|| g.sample_visible_of(gather(w), [F32x8::from_fn(|i| u(i).x), F32x8::from_fn(|i| u(i).y)]));
                 for i in 0..8 {
-                    let lane = lane(m, i);
-                    worst = worst.max((lane - g.sample_visible(w(i), u(i))).abs().max_element());
-                    samples.push(lane.to_array().map(f32::to_bits));
+                    let got = lane(m, i);
+                    worst = worst.max((got - g.sample_visible(w(i), u(i))).abs().max_element());
+                    samples.push(got.to_array().map(f32::to_bits));
                 }
             }
             by_isa.push(samples);

@@ -24,6 +24,7 @@ pub use sphere::{Sphere, SphereSample};
 pub use subdivision::catmull_clark;
 pub use topology::Topology;
 
+use crate::simd::{Real, V3};
 use glam::Vec3;
 
 /// Offset a point along the geometric normal `ng`, to the side of direction `w`, far enough
@@ -33,9 +34,19 @@ use glam::Vec3;
 /// positions carry a relative error of a few ulps, so a fixed epsilon fails far from the origin.
 #[inline]
 pub fn offset_ray_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+    offset_ray_origin_of(p.into(), ng.into(), w.into()).into()
+}
+
+/// [`offset_ray_origin`] in one lane or eight.
+#[inline(always)]
+pub fn offset_ray_origin_of<T: Real>(p: V3<T>, ng: V3<T>, w: V3<T>) -> V3<T> {
     /// Relative offset: 2^-24 (half an ulp of 1) times 1500, Mitsuba 3's `RayEpsilon`.
     const RAY_EPSILON: f32 = 1500.0 / 16_777_216.0;
-    let magnitude = (1.0 + p.abs().max_element()) * RAY_EPSILON;
-    let side = if ng.dot(w) >= 0.0 { magnitude } else { -magnitude };
+    // glam's max_element: max(max(x, y), z), each max keeping its second operand unless the
+    // first is larger.
+    let larger = |a: T, b: T| T::select(b.lt(a), a, b);
+    let largest = larger(larger(p.x.abs(), p.y.abs()), p.z.abs());
+    let magnitude = (T::splat(1.0) + largest) * T::splat(RAY_EPSILON);
+    let side = T::select(T::splat(0.0).le(ng.dot(w)), magnitude, -magnitude);
     p + ng * side
 }

@@ -3,8 +3,9 @@
 
 use super::LightSample;
 use crate::color::Rgb;
-use crate::geometry::{Sphere, offset_ray_origin};
+use crate::geometry::{Sphere, offset_ray_origin_of};
 use crate::sampling::{Distribution1D, warp};
+use crate::simd::{Real, V3};
 use glam::{Vec2, Vec3};
 
 /// A surface that emits `radiance` from its front: triangles of a mesh, or an exact sphere.
@@ -57,26 +58,22 @@ impl AreaLight {
         let (q, n, pdf) = match &self.surface {
             EmittingSurface::Triangles { triangles, normals, by_area } => {
                 let pick = by_area.sample_discrete(u.x);
-                let [a, b, c] = triangles[pick.index];
-                let bary = warp::square_to_uniform_triangle(Vec2::new(pick.u_remapped, u.y));
-                let q = a * (1.0 - bary.x - bary.y) + b * bary.x + c * bary.y;
+                let triangle = triangles[pick.index].map(V3::from);
                 let n = normals[pick.index];
-                let dist2 = (q - p).length_squared();
-                let cos_light = -n.dot((q - p) / dist2.sqrt());
-                (q, n, dist2 / (cos_light * self.area))
+                let (q, pdf) = triangle_point_of(p.into(), triangle, n.into(), [pick.u_remapped, u.y], self.area);
+                (q.into(), n, pdf)
             }
             EmittingSurface::Sphere(sphere) => {
                 let s = sphere.sample_from(p, u)?;
                 (s.point, s.normal, s.pdf)
             }
         };
-        let to_light = q - p;
-        let dist2 = to_light.length_squared();
-        let wi = to_light / dist2.sqrt();
-        if !(n.dot(wi) < 0.0 && dist2 > 0.0 && pdf > 0.0) {
+        let toward = toward_light_of(p.into(), q.into(), n.into(), pdf);
+        if !toward.valid {
             return None;
         }
-        Some(LightSample { wi, radiance: self.radiance, pdf, point: Some(offset_ray_origin(q, n, -wi)), delta: false })
+        let (wi, point) = (toward.wi.into(), toward.point.into());
+        Some(LightSample { wi, radiance: self.radiance, pdf, point: Some(point), delta: false })
     }
 
     /// Solid-angle density at `p` of sampling the point `q` with geometric normal `n`, reached
@@ -92,6 +89,87 @@ impl AreaLight {
                 if !(cos > 0.0) { 0.0 } else { dist2 / (cos * self.area) }
             }
             EmittingSurface::Sphere(sphere) => sphere.pdf_from(p, w),
+        }
+    }
+}
+
+/// A point q of the triangle with unit normal `n` drawn uniformly by area with `u`, and the
+/// solid-angle density at `p` of drawing it, |q - p|^2 / (cos theta_q `area`), `area` being the
+/// light's total area (the triangle was chosen in proportion to its own); in one lane or eight.
+#[inline(always)]
+pub fn triangle_point_of<T: Real>(p: V3<T>, [a, b, c]: [V3<T>; 3], n: V3<T>, u: [T; 2], area: f32) -> (V3<T>, T) {
+    let (b1, b2) = warp::square_to_uniform_triangle_of(u);
+    let q = a * (T::splat(1.0) - b1 - b2) + b * b1 + c * b2;
+    let d = q - p;
+    let dist2 = d.dot(d);
+    let cos_light = -n.dot(d / dist2.sqrt());
+    (q, dist2 / (cos_light * T::splat(area)))
+}
+
+/// The direction from `p` to a light's point `q` (unit normal `n`, drawn with density `pdf`),
+/// the point offset off the light towards `p` for the shadow ray, and whether the sample holds:
+/// `p` in front of the light, apart from it, with a positive density.
+#[derive(Clone, Copy, Debug)]
+pub struct TowardLight<T: Real> {
+    /// Unit direction from `p` to `q`.
+    pub wi: V3<T>,
+    /// `q` offset off the light's surface towards `p` ([`crate::geometry::offset_ray_origin`]).
+    pub point: V3<T>,
+    /// Where the sample holds.
+    pub valid: T::Mask,
+}
+
+/// [`TowardLight`] from `p` to the light's point `q`, in one lane or eight.
+#[inline(always)]
+pub fn toward_light_of<T: Real>(p: V3<T>, q: V3<T>, n: V3<T>, pdf: T) -> TowardLight<T> {
+    let zero = T::splat(0.0);
+    let to_light = q - p;
+    let dist2 = to_light.dot(to_light);
+    let wi = to_light / dist2.sqrt();
+    let valid = n.dot(wi).lt(zero) & zero.lt(dist2) & zero.lt(pdf);
+    TowardLight { wi, point: offset_ray_origin_of(q, n, -wi), valid }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::F32x8;
+    use crate::simd::testing::{direction, gather, isas, lane, numbers};
+
+    #[test]
+    fn lanes_sample_a_triangle_bit_for_bit_as_one_point_does() {
+        let [a, b, c] = [Vec3::new(-0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, -0.5), Vec3::new(0.5, 2.1, 0.5)];
+        let n = (b - a).cross(c - a).normalize();
+        let area = 0.7;
+        for isa in isas() {
+            for chunk in 0..2000 {
+                // Shading points around the triangle, in front of it and behind, and on it.
+                let p = |i: usize| match (chunk + i) % 61 {
+                    0 => a,
+                    _ => direction(chunk * 8 + i) * 3.0 + Vec3::Y,
+                };
+                let u = |i: usize| numbers(chunk, i);
+                let (q, pdf, toward) = isa.run(|| {
+                    let u = [F32x8::from_fn(|i| u(i)[0]), F32x8::from_fn(|i| u(i)[1])];
+                    let (q, pdf) =
+                        triangle_point_of(gather(p), [a, b, c].map(|v| gather(|_| v)), gather(|_| n), u, area);
+                    (q, pdf, toward_light_of(gather(p), q, gather(|_| n), pdf))
+                });
+                for i in 0..8 {
+                    let (one_q, one_pdf) =
+                        triangle_point_of(p(i).into(), [a, b, c].map(V3::from), n.into(), u(i), area);
+                    let one = toward_light_of(p(i).into(), one_q, n.into(), one_pdf);
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(
+                        (bits(lane(q, i)), pdf.0[i].to_bits(), bits(lane(toward.wi, i)), bits(lane(toward.point, i))),
+                        (bits(one_q.into()), one_pdf.to_bits(), bits(one.wi.into()), bits(one.point.into())),
+                        "{isa:?} p {} u {:?}",
+                        p(i),
+                        u(i)
+                    );
+                    assert_eq!(toward.valid.test(i), one.valid, "{isa:?} p {}", p(i));
+                }
+            }
         }
     }
 }

@@ -55,10 +55,17 @@ pub fn cosine_hemisphere_pdf_of<T: Real>(z: T) -> T {
 /// Uniform direction on the unit sphere.
 #[inline]
 pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.y;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let (s, c) = (2.0 * PI * u.x).sin_cos();
-    Vec3::new(r * c, r * s, z)
+    square_to_uniform_sphere_of([u.x, u.y]).into()
+}
+
+/// [`square_to_uniform_sphere`] in one lane or eight.
+#[inline(always)]
+pub fn square_to_uniform_sphere_of<T: Real>(u: [T; 2]) -> V3<T> {
+    let one = T::splat(1.0);
+    let z = one - T::splat(2.0) * u[1];
+    let r = (one - z * z).max(T::splat(0.0)).sqrt();
+    let (s, c) = (T::splat(2.0 * PI) * u[0]).sin_cos();
+    V3::new(r * c, r * s, z)
 }
 
 /// Density of [`square_to_uniform_sphere`].
@@ -86,8 +93,15 @@ pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
 /// vertices (the square-root parameterisation).
 #[inline]
 pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
-    let t = (1.0 - u.x).max(0.0).sqrt();
-    Vec2::new(1.0 - t, t * u.y)
+    let (b1, b2) = square_to_uniform_triangle_of([u.x, u.y]);
+    Vec2::new(b1, b2)
+}
+
+/// [`square_to_uniform_triangle`] in one lane or eight.
+#[inline(always)]
+pub fn square_to_uniform_triangle_of<T: Real>(u: [T; 2]) -> (T, T) {
+    let t = (T::splat(1.0) - u[0]).max(T::splat(0.0)).sqrt();
+    (T::splat(1.0) - t, t * u[1])
 }
 
 /// Sample x in [0, 1] with density proportional to the linear function from `a` (at 0) to `b`
@@ -203,5 +217,29 @@ mod tests {
         }
         let mean = sum / (n * n) as f32;
         assert!(mean.distance(Vec2::splat(1.0 / 3.0)) < 2e-3, "{mean}");
+    }
+
+    #[test]
+    fn uniform_sphere_lanes_match_one_direction_and_agree_across_instruction_sets() {
+        use crate::simd::F32x8;
+        use crate::simd::testing::{isas, lane, numbers};
+        let mut worst = 0.0f32;
+        let mut by_isa = Vec::new();
+        for isa in isas() {
+            let mut bits = Vec::new();
+            for chunk in 0..4000 {
+                let u = |i: usize| numbers(chunk, i);
+                let w =
+                    isa.run(|| square_to_uniform_sphere_of([F32x8::from_fn(|i| u(i)[0]), F32x8::from_fn(|i| u(i)[1])]));
+                for i in 0..8 {
+                    worst = worst.max((lane(w, i) - square_to_uniform_sphere(Vec2::from(u(i)))).abs().max_element());
+                    bits.push(lane(w, i).to_array().map(f32::to_bits));
+                }
+            }
+            by_isa.push(bits);
+        }
+        // z is exact; x and y carry the lanes' sine and cosine, within 2e-7.
+        assert!(worst < 2e-7, "largest difference from one direction {worst:e}");
+        assert!(by_isa.windows(2).all(|w| w[0] == w[1]), "AVX2 and portable lanes differ");
     }
 }

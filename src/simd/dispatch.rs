@@ -23,11 +23,6 @@ impl Isa {
         }
     }
 
-    /// The best instruction set this CPU runs.
-    pub fn detected() -> Isa {
-        if Isa::Avx2.available() { Isa::Avx2 } else { Isa::Portable }
-    }
-
     /// `f()`, compiled for this instruction set: everything `f` inlines (lane operations are all
     /// `#[inline(always)]`) is compiled for AVX2 under [`Isa::Avx2`]. Portable where `self` is
     /// not [`Isa::available`].
@@ -55,7 +50,6 @@ mod tests {
     #[test]
     fn the_portable_set_is_always_available_and_run_calls_f() {
         assert!(Isa::Portable.available());
-        assert!(Isa::detected().available());
         for isa in [Isa::Avx2, Isa::Portable] {
             assert_eq!(isa.run(|| 41 + 1), 42);
         }

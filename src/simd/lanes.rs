@@ -2,7 +2,7 @@
 //! which LLVM turns into one 256-bit instruction inside an AVX2 function ([`super::Isa`]) and
 //! two 128-bit ones elsewhere; nothing here names an instruction set. The loops index the
 //! lanes rather than call `array::map` or `array::from_fn`: a call that LLVM leaves out of line
-//! is compiled without AVX2, and where a kernel is large it did (the conductor's lanes ran 30%
+//! is compiled without AVX2, and where a kernel is large it did (the conductor's lanes ran 27%
 //! slower with AVX2 than without).
 #![allow(clippy::needless_range_loop)]
 

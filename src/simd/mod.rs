@@ -23,8 +23,8 @@ pub trait Mask: Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output
 
 impl Mask for bool {}
 
-/// A real number in one lane (`f32`) or eight ([`F32x8`]), with IEEE single-precision
-/// arithmetic in every lane.
+/// A real number in one lane (`f32`) or eight ([`F32x8`]), or a colour's three channels as
+/// lanes (glam's `Vec3A`), with IEEE single-precision arithmetic in every lane.
 pub trait Real:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
 {
@@ -194,6 +194,14 @@ impl<T: Real> Sub for V3<T> {
     #[inline(always)]
     fn sub(self, o: Self) -> Self {
         V3::new(self.x - o.x, self.y - o.y, self.z - o.z)
+    }
+}
+
+impl<T: Real> Neg for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        V3::new(-self.x, -self.y, -self.z)
     }
 }
 
