@@ -137,7 +137,7 @@ mod tests {
     use super::*;
     use crate::bsdf::fresnel::fresnel_conductor_of;
     use crate::simd::F32x8;
-    use crate::simd::testing::{direction, gather, isas, lane, numbers, upper_direction};
+    use crate::simd::testing::{direction, gather, isas, lane, numbers, on_every_isa, upper_direction};
 
     #[test]
     fn lanes_evaluate_and_fresnel_bit_for_bit_as_one_path_does() {
@@ -175,8 +175,7 @@ mod tests {
     fn lane_samples_match_one_path_and_agree_across_instruction_sets() {
         let ggx = Ggx::new(0.05, 0.3);
         let mut worst = 0.0f32;
-        let mut by_isa = Vec::new();
-        for isa in isas() {
+        on_every_isa(|isa| {
             let mut bits = Vec::new();
             for chunk in 0..4000 {
                 let wo = |i: usize| upper_direction(chunk * 8 + i);
@@ -209,11 +208,10 @@ mod tests {
                     );
                 }
             }
-            by_isa.push(bits);
-        }
+            bits
+        });
         // Directions absolutely, the cosine, factor and density relatively: the lanes' sine and
         // cosine differ from libm's in the last bits (3e-5 measured).
         assert!(worst < 2e-4, "largest difference from one path's terms {worst:e}");
-        assert!(by_isa.windows(2).all(|w| w[0] == w[1]), "AVX2 and portable lanes differ");
     }
 }

@@ -222,10 +222,9 @@ mod tests {
     #[test]
     fn uniform_sphere_lanes_match_one_direction_and_agree_across_instruction_sets() {
         use crate::simd::F32x8;
-        use crate::simd::testing::{isas, lane, numbers};
+        use crate::simd::testing::{lane, numbers, on_every_isa};
         let mut worst = 0.0f32;
-        let mut by_isa = Vec::new();
-        for isa in isas() {
+        on_every_isa(|isa| {
             let mut bits = Vec::new();
             for chunk in 0..4000 {
                 let u = |i: usize| numbers(chunk, i);
@@ -236,10 +235,9 @@ mod tests {
                     bits.push(lane(w, i).to_array().map(f32::to_bits));
                 }
             }
-            by_isa.push(bits);
-        }
+            bits
+        });
         // z is exact; x and y carry the lanes' sine and cosine, within 2e-7.
         assert!(worst < 2e-7, "largest difference from one direction {worst:e}");
-        assert!(by_isa.windows(2).all(|w| w[0] == w[1]), "AVX2 and portable lanes differ");
     }
 }

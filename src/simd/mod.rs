@@ -281,4 +281,11 @@ pub(crate) mod testing {
     pub fn isas() -> impl Iterator<Item = Isa> {
         [Isa::Portable, Isa::Avx2].into_iter().filter(|isa| isa.available())
     }
+
+    /// `run(isa)` for each instruction set this CPU runs, asserting that all give the same
+    /// result (the lanes' bits).
+    pub fn on_every_isa<T: PartialEq>(run: impl FnMut(Isa) -> T) {
+        let results: Vec<T> = isas().map(run).collect();
+        assert!(results.windows(2).all(|w| w[0] == w[1]), "AVX2 and portable lanes differ");
+    }
 }
