@@ -295,7 +295,11 @@ impl From<FootprintArg> for BakeFootprint {
 
 /// Parse the command line and run it.
 pub fn run() -> Result<ExitCode> {
-    match Cli::parse().command {
+    let command = Cli::parse().command;
+    // The lanes' instruction set, forced with TESSERA_SIMD: a bad value stops here, not later
+    // in a render that would quietly take another.
+    tessera::simd::Isa::from_env().map_err(|e| tessera::Error::param("TESSERA_SIMD", e))?;
+    match command {
         Command::Render {
             scene,
             output,
@@ -819,6 +823,16 @@ fn print_info(scene: &Scene) {
         l.distant.len() - suns
     );
     println!("memory     {:.1} MiB (geometry, BVH, textures)", scene.memory_bytes() as f64 / (1 << 20) as f64);
+    let tracer = tessera::integrator::PathTracer::new(scene, false, false);
+    let in_lanes: Vec<&str> = (0..scene.materials.len() as u32)
+        .filter(|&m| tracer.shades_in_lanes(m))
+        .map(|m| scene.materials[m as usize].name.as_str())
+        .collect();
+    let isa = tessera::simd::Isa::selected();
+    match in_lanes.is_empty() {
+        true => println!("lanes      none: every hit is shaded one at a time"),
+        false => println!("lanes      {isa:?}, 8 hits at a time on triangles of: {}", in_lanes.join(", ")),
+    }
 }
 
 /// `tessera montage`: read the images, caption them, grid them, write the result.

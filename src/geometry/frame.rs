@@ -1,5 +1,6 @@
 //! Orthonormal shading frames: world <-> local, with the normal along local +z.
 
+use crate::simd::{Real, V3};
 use glam::Vec3;
 
 /// An orthonormal frame `(s, t, n)`; local coordinates have `n` as +z, `s` as +x, `t` as +y.
@@ -19,25 +20,14 @@ impl Frame {
     /// A frame around `n` with an arbitrary but continuous tangent (Duff et al. 2017,
     /// "Building an Orthonormal Basis, Revisited"). `n` must be unit length.
     pub fn from_normal(n: Vec3) -> Self {
-        let sign = 1.0f32.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-        Frame { s, t, n }
+        FrameOf::from_normal(n.into()).into()
     }
 
     /// The shading frame of DESIGN.md section 3: `s = normalize(dpdu - n (n . dpdu))`,
     /// `t = n x s`. Falls back to [`Frame::from_normal`] when `dpdu` is (nearly) parallel to
     /// `n` or zero (a degenerate UV mapping).
     pub fn from_normal_tangent(n: Vec3, dpdu: Vec3) -> Self {
-        let s = dpdu - n * n.dot(dpdu);
-        let len2 = s.length_squared();
-        if !(len2 > 1e-20 * dpdu.length_squared().max(1e-30)) || !len2.is_finite() {
-            return Self::from_normal(n);
-        }
-        let s = s / len2.sqrt();
-        Frame { s, t: n.cross(s), n }
+        FrameOf::from_normal_tangent(n.into(), dpdu.into()).into()
     }
 
     /// The frame turned about n so that s points along the tangent-plane part of `direction`
@@ -56,13 +46,77 @@ impl Frame {
     /// World direction to local coordinates.
     #[inline]
     pub fn to_local(&self, v: Vec3) -> Vec3 {
-        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+        FrameOf::from(*self).to_local(v.into()).into()
     }
 
     /// Local direction to world coordinates.
     #[inline]
     pub fn to_world(&self, v: Vec3) -> Vec3 {
+        FrameOf::from(*self).to_world(v.into()).into()
+    }
+}
+
+/// [`Frame`] in one lane or eight: the same constructions written once over [`Real`], so that
+/// `FrameOf<f32>` computes what `Frame` does bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameOf<T: Real> {
+    /// First tangent (local +x).
+    pub s: V3<T>,
+    /// Second tangent (local +y).
+    pub t: V3<T>,
+    /// Normal (local +z).
+    pub n: V3<T>,
+}
+
+impl<T: Real> FrameOf<T> {
+    /// [`Frame::from_normal`] (Duff et al. 2017), in one lane or eight.
+    #[inline(always)]
+    pub fn from_normal(n: V3<T>) -> Self {
+        let one = T::splat(1.0);
+        let sign = one.copysign(n.z);
+        let a = -one / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = V3::new(one + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = V3::new(b, sign + n.y * n.y * a, -n.y);
+        FrameOf { s, t, n }
+    }
+
+    /// [`Frame::from_normal_tangent`], in one lane or eight: both constructions are computed
+    /// and the fallback kept where dp/du has no part in the tangent plane.
+    #[inline(always)]
+    pub fn from_normal_tangent(n: V3<T>, dpdu: V3<T>) -> Self {
+        let s = dpdu - n * n.dot(dpdu);
+        let len2 = s.dot(s);
+        let degenerate = !(T::splat(1e-20) * dpdu.dot(dpdu).max(T::splat(1e-30))).lt(len2) | !len2.is_finite();
+        let s = s / len2.sqrt();
+        let fallback = FrameOf::from_normal(n);
+        FrameOf { s: V3::select(degenerate, fallback.s, s), t: V3::select(degenerate, fallback.t, n.cross(s)), n }
+    }
+
+    /// World direction to local coordinates.
+    #[inline(always)]
+    pub fn to_local(&self, v: V3<T>) -> V3<T> {
+        V3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    /// Local direction to world coordinates.
+    #[inline(always)]
+    pub fn to_world(&self, v: V3<T>) -> V3<T> {
         self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+impl From<Frame> for FrameOf<f32> {
+    #[inline(always)]
+    fn from(f: Frame) -> Self {
+        FrameOf { s: f.s.into(), t: f.t.into(), n: f.n.into() }
+    }
+}
+
+impl From<FrameOf<f32>> for Frame {
+    #[inline(always)]
+    fn from(f: FrameOf<f32>) -> Self {
+        Frame { s: f.s.into(), t: f.t.into(), n: f.n.into() }
     }
 }
 
@@ -88,6 +142,37 @@ mod tests {
             assert_orthonormal(&f);
             let v = Vec3::new(0.2, -0.4, 0.7);
             assert!(f.to_world(f.to_local(v)).distance(v) < 1e-5);
+        }
+    }
+
+    #[test]
+    fn frames_in_lanes_are_the_frames_of_one_lane_bit_for_bit() {
+        use crate::simd::testing::{direction, isas};
+        // Tangents along the normal, zero, tiny, huge and ordinary.
+        let tangent = |k: usize, n: Vec3| match k % 6 {
+            0 => n * 2.0,
+            1 => Vec3::ZERO,
+            2 => direction(k + 1) * 1e-30,
+            3 => direction(k + 1) * 1e30,
+            _ => direction(k + 1) * 3.0,
+        };
+        for isa in isas() {
+            for chunk in 0..2000 {
+                let n: [Vec3; 8] = std::array::from_fn(|i| direction(chunk * 8 + i));
+                let dpdu: [Vec3; 8] = std::array::from_fn(|i| tangent(chunk * 8 + i, n[i]));
+                let frame = isa.run(|| FrameOf::from_normal_tangent(V3::from(n), V3::from(dpdu)));
+                for i in 0..8 {
+                    let one = Frame::from_normal_tangent(n[i], dpdu[i]);
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(
+                        [frame.s, frame.t, frame.n].map(|v| bits(v.lane(i))),
+                        [one.s, one.t, one.n].map(bits),
+                        "{isa:?} n {} dpdu {}",
+                        n[i],
+                        dpdu[i]
+                    );
+                }
+            }
         }
     }
 

@@ -1,6 +1,7 @@
 //! The surface interaction: everything shading needs to know about a ray hit.
 
-use super::{Frame, Ray, RayDifferential};
+use super::{Frame, FrameOf, Ray, RayDifferential};
+use crate::simd::{Real, V3};
 use glam::{Vec2, Vec3};
 
 /// A ray hit on a surface, with its shading frame, texture coordinates and texture footprint.
@@ -68,36 +69,14 @@ impl SurfaceInteraction {
     /// `Triangle::InteractionFromIntersection`). A mesh without texture coordinates gets
     /// uv = (b1, b2). A triangle whose UVs are degenerate gets an arbitrary tangent frame.
     pub fn from_triangle(tri: &TriangleVertices, b1: f32, b2: f32, t: f32, ray: &Ray, triangle: u32) -> Self {
-        let b0 = 1.0 - b1 - b2;
-        let [p0, p1, p2] = tri.p;
-        let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let ng = (p1 - p0).cross(p2 - p0).normalize();
-        let uvs = tri.uv.unwrap_or([Vec2::ZERO, Vec2::X, Vec2::Y]);
-        let uv = uvs[0] * b0 + uvs[1] * b1 + uvs[2] * b2;
-
-        let duv02 = uvs[0] - uvs[2];
-        let duv12 = uvs[1] - uvs[2];
-        let dp02 = p0 - p2;
-        let dp12 = p1 - p2;
-        let det = duv02.x * duv12.y - duv02.y * duv12.x;
-        let (mut dpdu, mut dpdv) = if det.abs() < 1e-12 {
-            (Vec3::ZERO, Vec3::ZERO)
-        } else {
-            let inv = 1.0 / det;
-            ((dp02 * duv12.y - dp12 * duv02.y) * inv, (dp12 * duv02.x - dp02 * duv12.x) * inv)
-        };
-        if !(dpdu.is_finite() && dpdv.is_finite()) || dpdu.cross(dpdv).length_squared() == 0.0 {
-            let f = Frame::from_normal(ng);
-            dpdu = f.s;
-            dpdv = f.t;
-        }
-
-        let ns = tri
-            .n
-            .map(|[n0, n1, n2]| (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero())
-            .filter(|n| *n != Vec3::ZERO)
-            .unwrap_or(ng);
-        Self::new(SurfacePoint { p, ng, shading_normal: ns, uv, dpdu, dpdv }, ray, t, triangle)
+        let surface = triangle_surface_of(
+            tri.p.map(V3::from),
+            tri.n.unwrap_or([Vec3::ZERO; 3]).map(V3::from),
+            tri.uv.unwrap_or(DEFAULT_UVS).map(|uv| [uv.x, uv.y]),
+            b1,
+            b2,
+        );
+        Self::new(surface.into(), ray, t, triangle)
     }
 
     /// The interaction at `point`, where `ray` met primitive `primitive` at parameter `t`: the
@@ -172,10 +151,103 @@ impl SurfaceInteraction {
     /// it hits nothing when the segment between them is clear.
     #[inline]
     pub fn spawn_ray_to(&self, target: Vec3) -> Ray {
-        let o = super::offset_ray_origin(self.p, self.ng, target - self.p);
-        /// Stop just short of the target: Mitsuba 3's `ShadowEpsilon` is ten `RayEpsilon`s.
-        const SHADOW_EPSILON: f32 = 10.0 * 1500.0 / 16_777_216.0;
-        Ray { o, d: target - o, t_max: 1.0 - SHADOW_EPSILON }
+        let (o, d) = shadow_ray_to_of(self.p.into(), self.ng.into(), target.into());
+        Ray { o: o.into(), d: d.into(), t_max: SHADOW_RAY_T_MAX }
+    }
+}
+
+/// Where a shadow ray towards a point ends ([`shadow_ray_to_of`]): just short of the point,
+/// since Mitsuba 3's `ShadowEpsilon` is ten `RayEpsilon`s.
+pub const SHADOW_RAY_T_MAX: f32 = 1.0 - 10.0 * 1500.0 / 16_777_216.0;
+
+/// The origin and direction of the shadow ray from `p` (geometric normal `ng`) to `target`, in
+/// one lane or eight: the origin offset off the surface towards the target
+/// ([`super::offset_ray_origin`]), the direction `target - origin`, so that the ray reaches the
+/// target at t = 1 and ends at [`SHADOW_RAY_T_MAX`].
+#[inline(always)]
+pub fn shadow_ray_to_of<T: Real>(p: V3<T>, ng: V3<T>, target: V3<T>) -> (V3<T>, V3<T>) {
+    let o = super::offset_ray_origin_of(p, ng, target - p);
+    (o, target - o)
+}
+
+/// The texture coordinates of a mesh without them: uv = (b1, b2).
+pub const DEFAULT_UVS: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
+
+/// A triangle's surface at a point, in one lane or eight ([`triangle_surface_of`]).
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleSurface<T: Real> {
+    /// Position.
+    pub p: V3<T>,
+    /// Geometric normal (the counter-clockwise winding's), unit length.
+    pub ng: V3<T>,
+    /// Interpolated shading normal, unit length; `ng` where the vertex normals sum to zero.
+    pub shading_normal: V3<T>,
+    /// Texture coordinates.
+    pub uv: [T; 2],
+    /// dp/du.
+    pub dpdu: V3<T>,
+    /// dp/dv.
+    pub dpdv: V3<T>,
+}
+
+/// The surface of triangles `p` (vertex normals `n`, zero where a mesh has none; texture
+/// coordinates `uv`) at barycentric coordinates `(b1, b2)`, in one lane or eight. dp/du and
+/// dp/dv solve `p_i - p_0 = dpdu (u_i - u_0) + dpdv (v_i - v_0)` (pbrt-v4
+/// `Triangle::InteractionFromIntersection`); where the UVs are degenerate they are the tangents
+/// of [`FrameOf::from_normal`] about the geometric normal.
+#[inline(always)]
+pub fn triangle_surface_of<T: Real>(
+    [p0, p1, p2]: [V3<T>; 3],
+    [n0, n1, n2]: [V3<T>; 3],
+    uvs: [[T; 2]; 3],
+    b1: T,
+    b2: T,
+) -> TriangleSurface<T> {
+    let zero = T::splat(0.0);
+    let b0 = T::splat(1.0) - b1 - b2;
+    let p = p0 * b0 + p1 * b1 + p2 * b2;
+    let ng = (p1 - p0).cross(p2 - p0).normalize();
+    let uv = [uvs[0][0] * b0 + uvs[1][0] * b1 + uvs[2][0] * b2, uvs[0][1] * b0 + uvs[1][1] * b1 + uvs[2][1] * b2];
+
+    let duv02 = [uvs[0][0] - uvs[2][0], uvs[0][1] - uvs[2][1]];
+    let duv12 = [uvs[1][0] - uvs[2][0], uvs[1][1] - uvs[2][1]];
+    let dp02 = p0 - p2;
+    let dp12 = p1 - p2;
+    let det = duv02[0] * duv12[1] - duv02[1] * duv12[0];
+    let inv = T::splat(1.0) / det;
+    let solvable = !det.abs().lt(T::splat(1e-12));
+    let dpdu = V3::select(solvable, (dp02 * duv12[1] - dp12 * duv02[1]) * inv, V3::splat(0.0));
+    let dpdv = V3::select(solvable, (dp12 * duv02[0] - dp02 * duv12[0]) * inv, V3::splat(0.0));
+    let cross = dpdu.cross(dpdv);
+    let degenerate = !(dpdu.is_finite() & dpdv.is_finite()) | cross.dot(cross).eq(zero);
+    let fallback = FrameOf::from_normal(ng);
+
+    // glam's normalize_or_zero, then the geometric normal in place of zero.
+    let ns = n0 * b0 + n1 * b1 + n2 * b2;
+    let rcp = T::splat(1.0) / ns.dot(ns).sqrt();
+    let ns = ns * rcp;
+    let usable = rcp.is_finite() & zero.lt(rcp) & !ns.is_zero();
+    TriangleSurface {
+        p,
+        ng,
+        shading_normal: V3::select(usable, ns, ng),
+        uv,
+        dpdu: V3::select(degenerate, fallback.s, dpdu),
+        dpdv: V3::select(degenerate, fallback.t, dpdv),
+    }
+}
+
+impl From<TriangleSurface<f32>> for SurfacePoint {
+    #[inline(always)]
+    fn from(s: TriangleSurface<f32>) -> Self {
+        SurfacePoint {
+            p: s.p.into(),
+            ng: s.ng.into(),
+            shading_normal: s.shading_normal.into(),
+            uv: Vec2::from_array(s.uv),
+            dpdu: s.dpdu.into(),
+            dpdv: s.dpdv.into(),
+        }
     }
 }
 
@@ -201,6 +273,65 @@ mod tests {
         si.set_footprint(Vec3::new(0.1, 0.2, 0.0), Vec3::new(0.0, -0.3, 0.0));
         assert!(si.duv_dx.distance(Vec2::new(0.05, 0.2 / 3.0)) < 1e-6);
         assert!(si.duv_dy.distance(Vec2::new(0.0, -0.1)) < 1e-6);
+    }
+
+    #[test]
+    fn lanes_reconstruct_hits_bit_for_bit_as_one_hit_does() {
+        use crate::simd::F32x8;
+        use crate::simd::testing::{direction, isas, numbers};
+        // Triangles of every size and orientation, without vertex normals, with them, with
+        // normals that cancel at the hit point, without UVs, with degenerate and with ordinary
+        // ones.
+        let triangle = |k: usize| {
+            let scale = [1e-3, 1.0, 40.0][k % 3];
+            let p = [0, 1, 2].map(|c| direction(k * 3 + c) * scale + Vec3::splat(0.1 * k as f32));
+            let n = match k % 4 {
+                0 => None,
+                1 => Some([-Vec3::Z, -Vec3::Z, -Vec3::Z]),
+                2 => Some([Vec3::Y, -Vec3::Y, Vec3::X]),
+                _ => Some([0, 1, 2].map(|c| direction(k * 5 + c))),
+            };
+            let uv = match k % 5 {
+                0 => None,
+                1 => Some([Vec2::splat(0.5); 3]),
+                _ => Some([0, 1, 2].map(|c| Vec2::new((k * 7 + c) as f32 * 0.37, (k + c * c) as f32 * 0.11).fract())),
+            };
+            TriangleVertices { p, n, uv }
+        };
+        let ray = Ray::new(Vec3::new(0.3, 2.0, 5.0), Vec3::new(0.1, -0.3, -1.0));
+        for isa in isas() {
+            for chunk in 0..1000 {
+                let tris: [TriangleVertices; 8] = std::array::from_fn(|i| triangle(chunk * 8 + i));
+                let b = |i: usize| {
+                    let [b1, b2] = numbers(chunk, i);
+                    if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) }
+                };
+                let corners = |f: &dyn Fn(&TriangleVertices) -> [Vec3; 3]| {
+                    [0, 1, 2].map(|c| V3::from(std::array::from_fn::<Vec3, 8, _>(|i| f(&tris[i])[c])))
+                };
+                let uvs =
+                    [0, 1, 2].map(|c| [0, 1].map(|k| F32x8::from_fn(|i| tris[i].uv.unwrap_or(DEFAULT_UVS)[c][k])));
+                let (b1, b2) = (F32x8::from_fn(|i| b(i).0), F32x8::from_fn(|i| b(i).1));
+                let (s, frame) = isa.run(|| {
+                    let s = triangle_surface_of(
+                        corners(&|t| t.p),
+                        corners(&|t| t.n.unwrap_or([Vec3::ZERO; 3])),
+                        uvs,
+                        b1,
+                        b2,
+                    );
+                    (s, FrameOf::from_normal_tangent(s.shading_normal, s.dpdu))
+                });
+                for (i, tri) in tris.iter().enumerate() {
+                    let one = SurfaceInteraction::from_triangle(tri, b(i).0, b(i).1, 1.0, &ray, 0);
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    let lanes = [s.p, s.ng, s.dpdu, s.dpdv, frame.s, frame.t, frame.n].map(|v| bits(v.lane(i)));
+                    let alone = [one.p, one.ng, one.dpdu, one.dpdv, one.frame.s, one.frame.t, one.frame.n].map(bits);
+                    assert_eq!(lanes, alone, "{isa:?} {tri:?} at {:?}", b(i));
+                    assert_eq!([s.uv[0].0[i], s.uv[1].0[i]].map(f32::to_bits), one.uv.to_array().map(f32::to_bits));
+                }
+            }
+        }
     }
 
     #[test]

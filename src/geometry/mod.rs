@@ -15,8 +15,11 @@ mod sphere;
 mod subdivision;
 mod topology;
 
-pub use frame::Frame;
-pub use interaction::{SurfaceInteraction, SurfacePoint, TriangleVertices};
+pub use frame::{Frame, FrameOf};
+pub use interaction::{
+    DEFAULT_UVS, SHADOW_RAY_T_MAX, SurfaceInteraction, SurfacePoint, TriangleSurface, TriangleVertices,
+    shadow_ray_to_of, triangle_surface_of,
+};
 pub use mesh::{Bounds, TriangleMesh};
 pub use quad_mesh::{QuadMesh, QuadMeshReport, load_quad_obj};
 pub use ray::{Ray, RayDifferential};

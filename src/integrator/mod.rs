@@ -2,6 +2,7 @@
 //! image is bit-identical whatever the number of threads.
 
 mod checkpoint;
+mod lanes;
 mod path;
 pub mod primary;
 mod progressive;

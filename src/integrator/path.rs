@@ -13,11 +13,13 @@
 //! shows only emitters seen directly and 2 adds direct lighting. Russian roulette starts once
 //! `rr_depth` segments are traced, continuing with probability min(max(throughput) eta^2, 0.95).
 
+use super::lanes::LaneBsdf;
 use crate::accel::Hit;
 use crate::color::Rgb;
-use crate::geometry::{Frame, Ray, RayDifferential};
+use crate::geometry::{Frame, Ray, RayDifferential, SurfaceInteraction};
 use crate::sampling::{Sampler, power_heuristic};
 use crate::scene::Scene;
+use crate::simd::Isa;
 use crate::texture::TexCtx;
 use glam::{Vec2, Vec3};
 
@@ -43,7 +45,7 @@ const RR_MAX_PROBABILITY: f32 = 0.95;
 
 /// The path tracer over a scene.
 pub struct PathTracer<'a> {
-    scene: &'a Scene,
+    pub(super) scene: &'a Scene,
     max_depth: u32,
     rr_depth: u32,
     /// Per material: whether a hit on it needs the texture footprint.
@@ -52,31 +54,35 @@ pub struct PathTracer<'a> {
     record_first_hit: bool,
     /// Whether the first hit's footprint is recorded (the footprint AOV).
     record_footprint: bool,
+    /// Per material: how lanes shade it, if they can ([`LaneBsdf::of`]).
+    lane_bsdfs: Vec<Option<LaneBsdf>>,
+    /// The instruction set of the lanes.
+    isa: Isa,
 }
 
 /// How the previous vertex sampled the current ray, for MIS at the next emitter hit.
 #[derive(Clone, Copy, Debug)]
-struct PreviousVertex {
-    p: Vec3,
-    pdf: f32,
-    delta: bool,
+pub(super) struct PreviousVertex {
+    pub(super) p: Vec3,
+    pub(super) pdf: f32,
+    pub(super) delta: bool,
 }
 
 /// One path of a wavefront: where it is, what it carries, what it has gathered.
 #[derive(Clone, Debug)]
 pub struct Path {
     /// The ray to the next vertex (the camera ray at first).
-    ray: Ray,
+    pub(super) ray: Ray,
     /// The camera ray's differentials (for the footprint at the first hit).
-    diff: RayDifferential,
+    pub(super) diff: RayDifferential,
     /// The closest hit of `ray`, once traced.
-    hit: Option<Hit>,
-    sampler: Sampler,
-    throughput: Rgb,
+    pub(super) hit: Option<Hit>,
+    pub(super) sampler: Sampler,
+    pub(super) throughput: Rgb,
     eta_scale: f32,
-    prev: PreviousVertex,
+    pub(super) prev: PreviousVertex,
     /// Segments traced so far (0: the camera ray).
-    depth: u32,
+    pub(super) depth: u32,
     /// Radiance gathered so far (all of it once the path has ended).
     pub radiance: Rgb,
     /// The camera ray's first hit, where the tracer records first hits and the ray hit something.
@@ -84,16 +90,20 @@ pub struct Path {
 }
 
 /// A light sample waiting for its shadow ray: the path it belongs to and what it adds.
-struct ShadowTest {
-    path: usize,
-    ray: Ray,
-    contribution: Rgb,
+pub(super) struct ShadowTest {
+    pub(super) path: usize,
+    pub(super) ray: Ray,
+    pub(super) contribution: Rgb,
 }
 
 /// The buffers of [`PathTracer::trace_wave`], kept from one wave to the next.
 #[derive(Default)]
 pub struct WaveBuffers {
     active: Vec<usize>,
+    /// The paths that go on after the current vertex.
+    alive: Vec<usize>,
+    /// Per material, the paths whose vertices lanes shade.
+    lane_groups: Vec<Vec<usize>>,
     shadow: Vec<ShadowTest>,
     camera_rays: Vec<Ray>,
     camera_hits: Vec<Option<Hit>>,
@@ -109,8 +119,11 @@ impl<'a> PathTracer<'a> {
             .iter()
             .map(|m| m.textures().iter().any(|id| scene.textures[id.0 as usize].uses_footprint()))
             .collect();
+        let lane_bsdfs = scene.materials.iter().map(|m| LaneBsdf::of(m, &scene.textures)).collect();
         PathTracer {
             scene,
+            lane_bsdfs,
+            isa: Isa::selected(),
             max_depth: scene.settings.max_depth.unwrap_or(u32::MAX),
             rr_depth: scene.settings.rr_depth,
             needs_footprint,
@@ -141,7 +154,8 @@ impl<'a> PathTracer<'a> {
     /// their camera rays, then shade all at their vertices, test all their shadow rays, trace
     /// all their next rays, and again.
     pub fn trace_wave(&self, paths: &mut [Path], buffers: &mut WaveBuffers) {
-        let WaveBuffers { active, shadow, camera_rays, camera_hits } = buffers;
+        let WaveBuffers { active, alive, lane_groups, shadow, camera_rays, camera_hits } = buffers;
+        lane_groups.resize_with(self.scene.materials.len(), Vec::new);
         // Neighbouring camera rays (a pixel's samples, or neighbouring pixels' in a pass of few
         // samples) are nearly parallel: the accelerator traces them as packets.
         camera_rays.clear();
@@ -156,7 +170,26 @@ impl<'a> PathTracer<'a> {
         active.extend(0..paths.len());
         while !active.is_empty() {
             shadow.clear();
-            active.retain(|&i| self.shade(i, &mut paths[i], shadow));
+            alive.clear();
+            for &i in active.iter() {
+                match self.lane_material(&paths[i]) {
+                    Some(material) => lane_groups[material as usize].push(i),
+                    None => {
+                        if self.shade(i, &mut paths[i], shadow) {
+                            alive.push(i);
+                        }
+                    }
+                }
+            }
+            for (material, group) in lane_groups.iter_mut().enumerate() {
+                if let Some(bsdf) = self.lane_bsdfs[material] {
+                    for lanes in group.chunks(8) {
+                        self.shade_lanes(self.isa, bsdf, material as u32, lanes, paths, shadow, alive);
+                    }
+                }
+                group.clear();
+            }
+            std::mem::swap(active, alive);
             self.scene.accel.queries(|queries| {
                 for test in shadow.iter() {
                     if !queries.occluded(&test.ray) {
@@ -168,6 +201,27 @@ impl<'a> PathTracer<'a> {
                 }
             });
         }
+    }
+
+    /// Whether hits on triangles of material `material` are shaded eight at a time in lanes
+    /// (`integrator::lanes`), unless they are emitters, the last vertex, or first hits recorded
+    /// for AOVs.
+    pub fn shades_in_lanes(&self, material: u32) -> bool {
+        self.lane_bsdfs.get(material as usize).is_some_and(Option::is_some)
+    }
+
+    /// The material of `path`'s hit where lanes shade it: a triangle of a material they shade,
+    /// not emitting, before the last segment, and not the first hit where that is recorded.
+    fn lane_material(&self, path: &Path) -> Option<u32> {
+        let hit = path.hit?;
+        if hit.primitive as usize >= self.scene.geometry.triangles.len()
+            || path.depth + 1 >= self.max_depth
+            || (path.depth == 0 && self.record_first_hit)
+        {
+            return None;
+        }
+        let shape = self.scene.shape_of(hit.primitive);
+        (shape.light.is_none() && self.lane_bsdfs[shape.material as usize].is_some()).then_some(shape.material)
     }
 
     /// Shade path `index` at the hit of its ray: add what it sees there, queue its light
@@ -199,14 +253,7 @@ impl<'a> PathTracer<'a> {
             return false;
         }
 
-        // Texture footprint, where a filtered texture needs it: from the camera ray's
-        // differentials at the first hit, from the camera-based approximation after (pbrt-v4).
-        let wants_footprint = self.needs_footprint[shape.material as usize] || (*depth == 0 && self.record_footprint);
-        if wants_footprint && (*depth > 0 || !si.footprint_from_differential(ray.o, diff)) {
-            let (dpdx, dpdy) = scene.camera.approximate_dp_dxy(si.p, si.ng);
-            si.set_footprint(dpdx, dpdy);
-        }
-        let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) };
+        let ctx = self.texture_context(&mut si, shape.material, *depth, ray.o, diff);
         let material = &scene.materials[shape.material as usize];
         let bsdf = material.bsdf(&scene.textures, &ctx);
         // Two-sided materials see the back as the front: mirror the local z axis to the
@@ -269,7 +316,34 @@ impl<'a> PathTracer<'a> {
         *prev = PreviousVertex { p: si.p, pdf: bs.pdf, delta: bs.delta };
         *ray = si.spawn_ray(wi);
         *depth += 1;
+        self.survives_roulette(path)
+    }
 
+    /// The texture lookup's context at `si` on `material`, for a path that has traced `depth`
+    /// segments along rays from `o` (the camera ray's differentials `diff`). The footprint is
+    /// set where a filtered texture needs it: from the camera ray's differentials at the first
+    /// hit, from the camera-based approximation after (pbrt-v4).
+    pub(super) fn texture_context(
+        &self,
+        si: &mut SurfaceInteraction,
+        material: u32,
+        depth: u32,
+        o: Vec3,
+        diff: &RayDifferential,
+    ) -> TexCtx {
+        let wants_footprint = self.needs_footprint[material as usize] || (depth == 0 && self.record_footprint);
+        if wants_footprint && (depth > 0 || !si.footprint_from_differential(o, diff)) {
+            let (dpdx, dpdy) = self.scene.camera.approximate_dp_dxy(si.p, si.ng);
+            si.set_footprint(dpdx, dpdy);
+        }
+        TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) }
+    }
+
+    /// Russian roulette for a path that has just been continued: once `rr_depth` segments are
+    /// traced, it goes on with probability min(max(throughput) eta^2, 0.95), its throughput
+    /// divided by that. False when the path ends here, or carries nothing.
+    pub(super) fn survives_roulette(&self, path: &mut Path) -> bool {
+        let Path { sampler, throughput, eta_scale, depth, .. } = path;
         if *depth >= self.rr_depth {
             let q = (throughput.max_element() * *eta_scale * *eta_scale).min(RR_MAX_PROBABILITY);
             if sampler.next_1d() >= q {

@@ -56,11 +56,10 @@ impl AreaLight {
     /// the directions it subtends; the density is converted to solid angle at `p`.
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         let (q, n, pdf) = match &self.surface {
-            EmittingSurface::Triangles { triangles, normals, by_area } => {
-                let pick = by_area.sample_discrete(u.x);
-                let triangle = triangles[pick.index].map(V3::from);
-                let n = normals[pick.index];
-                let (q, pdf) = triangle_point_of(p.into(), triangle, n.into(), [pick.u_remapped, u.y], self.area);
+            EmittingSurface::Triangles { .. } => {
+                let (triangle, n, u_remapped) = self.pick_triangle(u.x).expect("a mesh light");
+                let (q, pdf) =
+                    triangle_point_of(p.into(), triangle.map(V3::from), n.into(), [u_remapped, u.y], self.area);
                 (q.into(), n, pdf)
             }
             EmittingSurface::Sphere(sphere) => {
@@ -74,6 +73,17 @@ impl AreaLight {
         }
         let (wi, point) = (toward.wi.into(), toward.point.into());
         Some(LightSample { wi, radiance: self.radiance, pdf, point: Some(point), delta: false })
+    }
+
+    /// For a mesh light, the triangle that `u` picks in proportion to its area, its unit normal,
+    /// and `u` remapped to [0, 1) within the pick, for the point on it; None for a sphere.
+    #[inline]
+    pub fn pick_triangle(&self, u: f32) -> Option<([Vec3; 3], Vec3, f32)> {
+        let EmittingSurface::Triangles { triangles, normals, by_area } = &self.surface else {
+            return None;
+        };
+        let pick = by_area.sample_discrete(u);
+        Some((triangles[pick.index], normals[pick.index], pick.u_remapped))
     }
 
     /// Solid-angle density at `p` of sampling the point `q` with geometric normal `n`, reached
@@ -97,13 +107,13 @@ impl AreaLight {
 /// solid-angle density at `p` of drawing it, |q - p|^2 / (cos theta_q `area`), `area` being the
 /// light's total area (the triangle was chosen in proportion to its own); in one lane or eight.
 #[inline(always)]
-pub fn triangle_point_of<T: Real>(p: V3<T>, [a, b, c]: [V3<T>; 3], n: V3<T>, u: [T; 2], area: f32) -> (V3<T>, T) {
+pub fn triangle_point_of<T: Real>(p: V3<T>, [a, b, c]: [V3<T>; 3], n: V3<T>, u: [T; 2], area: T) -> (V3<T>, T) {
     let (b1, b2) = warp::square_to_uniform_triangle_of(u);
     let q = a * (T::splat(1.0) - b1 - b2) + b * b1 + c * b2;
     let d = q - p;
     let dist2 = d.dot(d);
     let cos_light = -n.dot(d / dist2.sqrt());
-    (q, dist2 / (cos_light * T::splat(area)))
+    (q, dist2 / (cos_light * area))
 }
 
 /// The direction from `p` to a light's point `q` (unit normal `n`, drawn with density `pdf`),
@@ -151,8 +161,13 @@ mod tests {
                 let u = |i: usize| numbers(chunk, i);
                 let (q, pdf, toward) = isa.run(|| {
                     let u = [F32x8::from_fn(|i| u(i)[0]), F32x8::from_fn(|i| u(i)[1])];
-                    let (q, pdf) =
-                        triangle_point_of(gather(p), [a, b, c].map(|v| gather(|_| v)), gather(|_| n), u, area);
+                    let (q, pdf) = triangle_point_of(
+                        gather(p),
+                        [a, b, c].map(|v| gather(|_| v)),
+                        gather(|_| n),
+                        u,
+                        F32x8::splat(area),
+                    );
                     (q, pdf, toward_light_of(gather(p), q, gather(|_| n), pdf))
                 });
                 for i in 0..8 {

@@ -17,6 +17,7 @@ pub use environment::{Environment, EnvironmentMap};
 pub use point::{PointLight, SpotCone, SpotFalloff};
 
 use crate::sampling::power_heuristic;
+use crate::simd::{F32x8, M32x8, Real, V3};
 
 use crate::color::Rgb;
 use glam::{Vec2, Vec3};
@@ -35,6 +36,25 @@ pub struct LightSample {
     /// Whether the light is a delta light (`pdf` then is a discrete probability, and no BSDF
     /// sample can reach it).
     pub delta: bool,
+}
+
+/// Light samples for eight points in lanes ([`Lights::sample_lanes`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LightSampleLanes {
+    /// Unit directions towards the lights.
+    pub wi: V3<F32x8>,
+    /// Radiance arriving along `-wi`: red, green and blue as x, y and z.
+    pub radiance: V3<F32x8>,
+    /// Solid-angle densities, including the choice of the light.
+    pub pdf: F32x8,
+    /// The sampled points, offset off their lights, where the light is not at infinity.
+    pub point: V3<F32x8>,
+    /// Lanes whose light is at infinity (the environment, suns): their shadow rays have no end.
+    pub at_infinity: M32x8,
+    /// Lanes whose light is a delta light (`pdf` then is a discrete probability).
+    pub delta: M32x8,
+    /// Lanes whose sample holds.
+    pub valid: M32x8,
 }
 
 /// All lights of a scene.
@@ -72,15 +92,23 @@ impl Lights {
         1.0 / self.count().max(1) as u32 as f32
     }
 
-    /// Choose a light uniformly with `u_select` and sample it from `p` with `u`.
-    pub fn sample(&self, p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
+    /// The light that `u_select` chooses, uniformly; None without lights.
+    #[inline]
+    fn choose(&self, u_select: f32) -> Option<usize> {
         let n = self.count();
-        if n == 0 {
-            return None;
-        }
         // Through u32, which x86-64 converts to and from f32 in one or two instructions (u64 and
         // usize take a branch each way); no scene holds 2^32 lights.
-        let i = ((u_select * n as u32 as f32) as u32 as usize).min(n - 1);
+        (n > 0).then(|| ((u_select * n as u32 as f32) as u32 as usize).min(n - 1))
+    }
+
+    /// Choose a light uniformly with `u_select` and sample it from `p` with `u`.
+    pub fn sample(&self, p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
+        self.sample_chosen(self.choose(u_select)?, p, u)
+    }
+
+    /// Sample light `i` (areas first, then points, directional lights and suns, and the
+    /// environment) from `p` with `u`; the density includes the light's choice.
+    fn sample_chosen(&self, i: usize, p: Vec3, u: Vec2) -> Option<LightSample> {
         let (points, distant) = (self.area.len(), self.area.len() + self.points.len());
         let environment = distant + self.distant.len();
         let mut s = match i {
@@ -91,6 +119,65 @@ impl Lights {
         };
         s.pdf *= self.selection_pdf();
         Some(s)
+    }
+
+    /// [`Lights::sample`] from eight points `p` in lanes, with the numbers `u_select` and `u`
+    /// of each lane. The light, and a mesh light's triangle, are chosen lane by lane; the point
+    /// on the triangle and a constant environment's direction are computed in lanes, and the
+    /// one each lane chose kept. Other lights (spheres, points, suns, environment maps) are
+    /// sampled lane by lane ([`Lights::sample`]).
+    #[inline(always)]
+    pub fn sample_lanes(&self, p: V3<F32x8>, u_select: [f32; 8], u: [[f32; 2]; 8]) -> LightSampleLanes {
+        let mut triangle = [[Vec3::ZERO; 8]; 3];
+        let mut normal = [Vec3::ZERO; 8];
+        let (mut u_triangle, mut area) = ([0.0; 8], [1.0; 8]);
+        let mut radiance = [Vec3::ZERO; 8];
+        // Lanes that chose a light, that chose the constant sky, and those sampled one at a time
+        // (with what that gave).
+        let (mut chosen, mut sky, mut alone) = ([false; 8], [false; 8], [false; 8]);
+        let (mut alone_wi, mut alone_point, mut alone_pdf) = ([Vec3::ZERO; 8], [Vec3::ZERO; 8], [0.0; 8]);
+        let (mut alone_valid, mut alone_at_infinity, mut delta) = ([false; 8], [false; 8], [false; 8]);
+        let sky_index = self.count() - 1;
+        for lane in 0..8 {
+            let Some(i) = self.choose(u_select[lane]) else { continue };
+            chosen[lane] = true;
+            let mesh = self.area.get(i).and_then(|light| Some((light, light.pick_triangle(u[lane][0])?)));
+            if let Some((light, (vertices, n, u_remapped))) = mesh {
+                for (corner, v) in triangle.iter_mut().zip(vertices) {
+                    corner[lane] = v;
+                }
+                (normal[lane], u_triangle[lane], area[lane]) = (n, u_remapped, light.area());
+                radiance[lane] = light.radiance.into();
+            } else if let (true, Some(Environment::Constant(c))) = (i == sky_index, &self.environment) {
+                sky[lane] = true;
+                radiance[lane] = (*c).into();
+            } else {
+                alone[lane] = true;
+                let Some(s) = self.sample_chosen(i, p.lane(lane), Vec2::from(u[lane])) else { continue };
+                (alone_valid[lane], alone_wi[lane], alone_pdf[lane]) = (true, s.wi, s.pdf);
+                (alone_point[lane], alone_at_infinity[lane]) = (s.point.unwrap_or(Vec3::ZERO), s.point.is_none());
+                (radiance[lane], delta[lane]) = (s.radiance.into(), s.delta);
+            }
+        }
+        let u_x = F32x8::from_fn(|lane| u[lane][0]);
+        let u_y = F32x8::from_fn(|lane| u[lane][1]);
+        let normal = V3::from(normal);
+        let (q, pdf) =
+            area::triangle_point_of(p, triangle.map(V3::from), normal, [F32x8(u_triangle), u_y], F32x8(area));
+        let toward = area::toward_light_of(p, q, normal, pdf);
+        let (sky, alone) = (M32x8::from_bools(sky), M32x8::from_bools(alone));
+        let pdf = F32x8::select(sky, F32x8::splat(crate::sampling::warp::UNIFORM_SPHERE_PDF), pdf);
+        let wi = V3::select(sky, crate::sampling::warp::square_to_uniform_sphere_of([u_x, u_y]), toward.wi);
+        let in_lanes_valid = sky | toward.valid;
+        LightSampleLanes {
+            wi: V3::select(alone, V3::from(alone_wi), wi),
+            radiance: V3::from(radiance),
+            pdf: F32x8::select(alone, F32x8(alone_pdf), pdf * F32x8::splat(self.selection_pdf())),
+            point: V3::select(alone, V3::from(alone_point), toward.point),
+            at_infinity: sky | M32x8::from_bools(alone_at_infinity),
+            delta: M32x8::from_bools(delta),
+            valid: M32x8::from_bools(chosen) & ((alone & M32x8::from_bools(alone_valid)) | (!alone & in_lanes_valid)),
+        }
     }
 
     /// Radiance arriving along unit direction `d` from the lights at infinity (the environment
@@ -124,5 +211,81 @@ impl Lights {
     /// `w` met it ([`AreaLight::pdf`]).
     pub fn area_pdf(&self, light: usize, p: Vec3, w: Vec3, p_light: Vec3, n_light: Vec3) -> f32 {
         self.area[light].pdf(p, w, p_light, n_light) * self.selection_pdf()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Sphere;
+    use crate::simd::testing::{direction, gather, isas, numbers};
+
+    #[test]
+    fn lanes_sample_the_lights_as_one_point_does() {
+        // Two mesh lights (one of two triangles) of different radiance and a constant sky.
+        let square = vec![
+            [Vec3::new(-0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, 0.5)],
+            [Vec3::new(-0.5, 2.0, -0.5), Vec3::new(0.5, 2.0, 0.5), Vec3::new(-0.5, 2.0, 0.5)],
+        ];
+        let tilted = vec![[Vec3::new(2.0, 0.0, 0.0), Vec3::new(2.0, 1.0, 0.0), Vec3::new(2.5, 0.0, 1.0)]];
+        // A sphere light and a point light are sampled one lane at a time.
+        let sphere = Sphere::new(glam::Mat4::from_translation(Vec3::new(-2.0, 0.5, 0.0)), false).unwrap();
+        let lights = Lights {
+            area: vec![
+                AreaLight::new(square, Rgb::splat(5.0)),
+                AreaLight::new(tilted, Rgb::new(1.0, 2.0, 3.0)),
+                AreaLight::sphere(sphere, Rgb::new(3.0, 2.0, 1.0)),
+            ],
+            points: vec![PointLight {
+                position: Vec3::new(0.0, 3.0, 1.0),
+                intensity: Rgb::ONE,
+                spot: None,
+                range: None,
+            }],
+            environment: Some(Environment::Constant(Rgb::new(0.2, 0.3, 0.4))),
+            ..Default::default()
+        };
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        let mut seen = [0; 3];
+        for isa in isas() {
+            for chunk in 0..2000 {
+                // Points around the lights: in front of them, behind, and on them.
+                let p = |i: usize| match (chunk + i) % 53 {
+                    0 => Vec3::new(0.1, 2.0, 0.1),
+                    _ => direction(chunk * 8 + i) * 3.0,
+                };
+                let u_select: [f32; 8] = std::array::from_fn(|i| numbers(chunk + 7, i)[0]);
+                let u: [[f32; 2]; 8] = std::array::from_fn(|i| numbers(chunk, i));
+                let lanes = isa.run(|| lights.sample_lanes(gather(p), u_select, u));
+                for i in 0..8 {
+                    let Some(one) = lights.sample(p(i), u_select[i], Vec2::from(u[i])) else {
+                        assert!(!lanes.valid.test(i), "{isa:?} p {} u {:?}", p(i), u[i]);
+                        seen[2] += 1;
+                        continue;
+                    };
+                    assert!(lanes.valid.test(i), "{isa:?} p {} u {:?}", p(i), u[i]);
+                    assert_eq!(bits(lanes.radiance.lane(i)), bits(one.radiance.into()));
+                    assert_eq!(lanes.pdf.0[i].to_bits(), one.pdf.to_bits());
+                    assert_eq!(lanes.delta.test(i), one.delta);
+                    match one.point {
+                        // A mesh light's sample involves no sine, the others are one lane's:
+                        // the same bits.
+                        Some(point) => {
+                            assert!(!lanes.at_infinity.test(i));
+                            assert_eq!(bits(lanes.wi.lane(i)), bits(one.wi), "{isa:?} p {} u {:?}", p(i), u[i]);
+                            assert_eq!(bits(lanes.point.lane(i)), bits(point));
+                            seen[0] += 1;
+                        }
+                        // The sky's direction is within the lanes' sine of the libm one's.
+                        None => {
+                            assert!(lanes.at_infinity.test(i));
+                            assert!(lanes.wi.lane(i).distance(one.wi) < 4e-7, "{} {}", lanes.wi.lane(i), one.wi);
+                            seen[1] += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 500), "points, sky and failed samples seen {seen:?} times");
     }
 }

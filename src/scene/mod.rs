@@ -154,7 +154,7 @@ impl Geometry {
     }
 
     /// All vertex data of triangle `i`.
-    #[inline]
+    #[inline(always)]
     pub fn triangle_vertices(&self, i: usize) -> TriangleVertices {
         let idx = self.triangles[i];
         let shape = &self.shapes[self.triangle_shape[i] as usize];

@@ -23,6 +23,31 @@ impl Isa {
         }
     }
 
+    /// The best instruction set this CPU runs.
+    pub fn best() -> Isa {
+        if Isa::Avx2.available() { Isa::Avx2 } else { Isa::Portable }
+    }
+
+    /// The instruction set that the environment variable `TESSERA_SIMD` asks for (`avx2` or
+    /// `portable`), or [`Isa::best`] where it is unset or empty. An error says what is wrong
+    /// with the value: neither, or `avx2` on a CPU without it.
+    pub fn from_env() -> Result<Isa, String> {
+        match std::env::var("TESSERA_SIMD").as_deref() {
+            Err(_) | Ok("") => Ok(Isa::best()),
+            Ok("portable") => Ok(Isa::Portable),
+            Ok("avx2") if Isa::Avx2.available() => Ok(Isa::Avx2),
+            Ok("avx2") => Err("avx2 was asked for, but this CPU has no AVX2".into()),
+            Ok(other) => Err(format!("{other:?} is not an instruction set: expected avx2 or portable")),
+        }
+    }
+
+    /// [`Isa::from_env`], read once per process; [`Isa::best`] where that is an error (which
+    /// the command line reports before it renders).
+    pub fn selected() -> Isa {
+        static SELECTED: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
+        *SELECTED.get_or_init(|| Isa::from_env().unwrap_or_else(|_| Isa::best()))
+    }
+
     /// `f()`, compiled for this instruction set: everything `f` inlines (lane operations are all
     /// `#[inline(always)]`) is compiled for AVX2 under [`Isa::Avx2`]. Portable where `self` is
     /// not [`Isa::available`].

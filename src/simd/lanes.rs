@@ -152,6 +152,16 @@ impl Not for M32x8 {
 impl Mask for M32x8 {}
 
 impl M32x8 {
+    /// The mask that holds in lane i where `set[i]`.
+    #[inline(always)]
+    pub fn from_bools(set: [bool; 8]) -> Self {
+        let mut out = [0; 8];
+        for i in 0..8 {
+            out[i] = if set[i] { u32::MAX } else { 0 };
+        }
+        M32x8(out)
+    }
+
     /// Whether lane `i` is set.
     #[inline(always)]
     pub fn test(self, i: usize) -> bool {
@@ -201,5 +211,25 @@ impl Real for F32x8 {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         trig::sin_cos(self)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        const SIGN: u32 = 0x8000_0000;
+        let (a, b) = (self.to_bits(), sign.to_bits());
+        let mut out = [0; 8];
+        for i in 0..8 {
+            out[i] = (a[i] & !SIGN) | (b[i] & SIGN);
+        }
+        F32x8::from_bits(out)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> M32x8 {
+        const EXPONENT: u32 = 0x7f80_0000;
+        let bits = self.to_bits();
+        let mut out = [0; 8];
+        for i in 0..8 {
+            out[i] = if bits[i] & EXPONENT != EXPONENT { u32::MAX } else { 0 };
+        }
+        M32x8(out)
     }
 }

@@ -49,6 +49,10 @@ pub trait Real:
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
     /// (sin x, cos x): libm's for `f32`, [`trig::sin_cos`] in lanes.
     fn sin_cos(self) -> (Self, Self);
+    /// The magnitude of `self` with the sign bit of `sign`, per lane.
+    fn copysign(self, sign: Self) -> Self;
+    /// Neither infinite nor NaN, per lane.
+    fn is_finite(self) -> Self::Mask;
 }
 
 impl Real for f32 {
@@ -88,6 +92,14 @@ impl Real for f32 {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         f32::sin_cos(self)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        f32::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
     }
 }
 
@@ -132,6 +144,14 @@ impl Real for glam::Vec3A {
     fn sin_cos(self) -> (Self, Self) {
         let ((sx, cx), (sy, cy), (sz, cz)) = (self.x.sin_cos(), self.y.sin_cos(), self.z.sin_cos());
         (glam::Vec3A::new(sx, sy, sz), glam::Vec3A::new(cx, cy, cz))
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        glam::Vec3A::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> glam::BVec3A {
+        self.is_finite_mask()
     }
 }
 
@@ -178,6 +198,25 @@ impl<T: Real> V3<T> {
     #[inline(always)]
     pub fn select(mask: T::Mask, a: Self, b: Self) -> Self {
         V3::new(T::select(mask, a.x, b.x), T::select(mask, a.y, b.y), T::select(mask, a.z, b.z))
+    }
+
+    /// `x` in every component.
+    #[inline(always)]
+    pub fn splat(x: f32) -> Self {
+        V3::new(T::splat(x), T::splat(x), T::splat(x))
+    }
+
+    /// Whether every component is finite, per lane.
+    #[inline(always)]
+    pub fn is_finite(self) -> T::Mask {
+        self.x.is_finite() & self.y.is_finite() & self.z.is_finite()
+    }
+
+    /// Whether every component is zero, per lane.
+    #[inline(always)]
+    pub fn is_zero(self) -> T::Mask {
+        let zero = T::splat(0.0);
+        self.x.eq(zero) & self.y.eq(zero) & self.z.eq(zero)
     }
 }
 
@@ -235,6 +274,22 @@ impl From<V3<f32>> for glam::Vec3 {
     }
 }
 
+impl From<[glam::Vec3; 8]> for V3<F32x8> {
+    /// Eight vectors into lanes (a gather, outside the lane kernels).
+    #[inline(always)]
+    fn from(v: [glam::Vec3; 8]) -> Self {
+        V3::new(F32x8::from_fn(|i| v[i].x), F32x8::from_fn(|i| v[i].y), F32x8::from_fn(|i| v[i].z))
+    }
+}
+
+impl V3<F32x8> {
+    /// Lane `i`.
+    #[inline(always)]
+    pub fn lane(self, i: usize) -> glam::Vec3 {
+        glam::Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
+    }
+}
+
 /// What the lane tests of the BSDFs share.
 #[cfg(test)]
 pub(crate) mod testing {
@@ -243,12 +298,12 @@ pub(crate) mod testing {
 
     /// Eight lanes from `f(i)`, i the lane.
     pub fn gather(f: impl Fn(usize) -> Vec3) -> V3<F32x8> {
-        V3::new(F32x8::from_fn(|i| f(i).x), F32x8::from_fn(|i| f(i).y), F32x8::from_fn(|i| f(i).z))
+        V3::from(std::array::from_fn::<Vec3, 8, _>(f))
     }
 
     /// Lane `i` of `v`.
     pub fn lane(v: V3<F32x8>, i: usize) -> Vec3 {
-        Vec3::new(v.x.0[i], v.y.0[i], v.z.0[i])
+        v.lane(i)
     }
 
     /// Directions over the sphere, and the poles, the horizon and a direction a hair off the

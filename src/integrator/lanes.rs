@@ -1,0 +1,373 @@
+//! Shading eight paths at a time (issue 19): the stage of [`PathTracer::trace_wave`] that
+//! shades a group of up to eight path vertices on triangles of one material in SIMD lanes
+//! ([`crate::simd`]), where the material is written over [`Real`]: rough conductors with
+//! constant parameters and diffuse surfaces (their reflectance looked up path by path), without
+//! normal maps or texture frames. Mesh lights and a constant environment are sampled in lanes,
+//! other lights lane by lane ([`crate::light::Lights::sample_lanes`]). Other vertices are
+//! shaded one at a time ([`PathTracer::shade`]).
+//!
+//! Lanes gather what they need path by path (the triangle, the ray, the sampler's numbers, the
+//! light's triangle, the texture's reflectance), compute the hit point, the shading frame, the
+//! light sample, both BSDF evaluations, the MIS weight, the shadow ray and the next ray eight at
+//! a time, and hand the results back path by path. Each path draws the numbers that a path
+//! shaded alone draws, in the same order (the light's choice, its point, the lobe, the
+//! direction, Russian roulette), and nothing a lane computes depends on the other lanes, so the
+//! image depends neither on how paths are grouped nor on the instruction set ([`Isa`]). It
+//! differs from one-at-a-time shading only by the lanes' sine and cosine
+//! ([`crate::simd::trig`]), within the last bits of a sampled direction.
+
+use super::path::{Path, PathTracer, PreviousVertex, ShadowTest};
+use crate::bsdf::fresnel::fresnel_conductor_of;
+use crate::bsdf::{Bsdf, Conductor, ConductorFresnel, Diffuse, Ggx};
+use crate::color::Rgb;
+use crate::geometry::{
+    DEFAULT_UVS, Frame, FrameOf, Ray, SHADOW_RAY_T_MAX, SurfaceInteraction, TriangleSurface, offset_ray_origin_of,
+    shadow_ray_to_of, triangle_surface_of,
+};
+use crate::material::Material;
+use crate::sampling::power_heuristic_of;
+use crate::simd::{F32x8, Isa, M32x8, Real, V3};
+use crate::texture::{TexCtx, Texture};
+use glam::{Vec2, Vec3};
+
+/// Eight lanes.
+const LANES: usize = 8;
+
+/// How lanes shade a material ([`LaneBsdf::of`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum LaneBsdf {
+    /// A rough conductor with constant parameters.
+    RoughConductor {
+        /// Its microfacet distribution.
+        ggx: Ggx,
+        /// Real part of the IOR.
+        eta: Rgb,
+        /// Imaginary part of the IOR.
+        k: Rgb,
+        /// Factor on the reflectance.
+        specular_reflectance: Rgb,
+    },
+    /// Lambertian reflection, its reflectance looked up path by path.
+    Diffuse,
+}
+
+impl LaneBsdf {
+    /// How lanes shade `material`, if they can: a rough conductor whose parameters are constant,
+    /// or a diffuse BSDF; neither under a normal map or a texture frame.
+    pub(super) fn of(material: &Material, textures: &[Texture]) -> Option<LaneBsdf> {
+        if material.normal_map.is_some() || material.texture_frame.is_some() {
+            return None;
+        }
+        let anywhere = TexCtx { uv: Vec2::ZERO, duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO, uv_mirrored: None };
+        match material.bsdf(textures, &anywhere) {
+            Bsdf::Diffuse(_) => Some(LaneBsdf::Diffuse),
+            Bsdf::Conductor(Conductor {
+                ggx: Some(ggx),
+                fresnel: ConductorFresnel::Complex { eta, k },
+                specular_reflectance,
+            }) if material.textures().is_empty() => {
+                Some(LaneBsdf::RoughConductor { ggx, eta, k, specular_reflectance })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// What the lanes gather from the paths of a group.
+struct Gathered {
+    triangle: [V3<F32x8>; 3],
+    normals: [V3<F32x8>; 3],
+    uvs: [[F32x8; 2]; 3],
+    b1: F32x8,
+    b2: F32x8,
+    direction: V3<F32x8>,
+    throughput: V3<F32x8>,
+    u_select: [f32; LANES],
+    u_light: [[f32; 2]; LANES],
+    u_direction: [F32x8; 2],
+}
+
+/// What the lanes hand back to the paths of a group.
+struct Shaded {
+    /// Where next-event estimation's sample adds `contribution` if `shadow_ray` is clear.
+    contributes: M32x8,
+    contribution: V3<F32x8>,
+    shadow_origin: V3<F32x8>,
+    shadow_direction: V3<F32x8>,
+    shadow_t_max: F32x8,
+    /// Where the BSDF sample continues the path.
+    continues: M32x8,
+    weight: V3<F32x8>,
+    pdf: F32x8,
+    position: V3<F32x8>,
+    next_origin: V3<F32x8>,
+    next_direction: V3<F32x8>,
+}
+
+impl PathTracer<'_> {
+    /// Shade the paths `group` (one to eight indices into `paths`), whose rays hit triangles of
+    /// material `material` that lanes shade as `bsdf`: queue their light samples' shadow tests
+    /// in `shadow`, continue their rays, and push the paths that go on to `alive`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn shade_lanes(
+        &self,
+        isa: Isa,
+        bsdf: LaneBsdf,
+        material: u32,
+        group: &[usize],
+        paths: &mut [Path],
+        shadow: &mut Vec<ShadowTest>,
+        alive: &mut Vec<usize>,
+    ) {
+        debug_assert!((1..=LANES).contains(&group.len()));
+        let scene = self.scene;
+        let gathered = self.gather(group, paths);
+        let surface = isa.run(
+            #[inline(always)]
+            || {
+                let s =
+                    triangle_surface_of(gathered.triangle, gathered.normals, gathered.uvs, gathered.b1, gathered.b2);
+                (s, FrameOf::from_normal_tangent(s.shading_normal, s.dpdu), -gathered.direction.normalize())
+            },
+        );
+        let (s, frame, wo) = surface;
+        let material_ref = &scene.materials[material as usize];
+        let reflectance = match bsdf {
+            LaneBsdf::Diffuse => self.reflectances(group, paths, material, &s, &frame, wo),
+            LaneBsdf::RoughConductor { .. } => V3::splat(0.0),
+        };
+        let two_sided = material_ref.two_sided;
+        let shaded = isa.run(
+            #[inline(always)]
+            || {
+                // Two-sided materials see the back as the front: the normal mirrored to the viewer.
+                let mut frame = frame;
+                if two_sided {
+                    frame.n = V3::select(frame.n.dot(wo).lt(F32x8::splat(0.0)), -frame.n, frame.n);
+                }
+                shade(bsdf, &scene.lights, &gathered, &s, &frame, wo, reflectance)
+            },
+        );
+        for (lane, &index) in group.iter().enumerate() {
+            let path = &mut paths[index];
+            if shaded.contributes.test(lane) {
+                let ray = Ray {
+                    o: shaded.shadow_origin.lane(lane),
+                    d: shaded.shadow_direction.lane(lane),
+                    t_max: shaded.shadow_t_max.0[lane],
+                };
+                shadow.push(ShadowTest { path: index, ray, contribution: shaded.contribution.lane(lane).into() });
+            }
+            if !shaded.continues.test(lane) {
+                continue;
+            }
+            path.throughput *= Rgb::from(shaded.weight.lane(lane));
+            path.prev = PreviousVertex { p: shaded.position.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
+            path.ray = Ray::new(shaded.next_origin.lane(lane), shaded.next_direction.lane(lane));
+            path.depth += 1;
+            if self.survives_roulette(path) {
+                alive.push(index);
+            }
+        }
+    }
+
+    /// The group's triangles, rays and throughputs, and the numbers each path draws for its
+    /// light sample and its BSDF sample (the lobe's number too, unused by these BSDFs, so that
+    /// the paths draw what one-at-a-time shading draws). Lanes past the group's end repeat its
+    /// first path, without drawing.
+    fn gather(&self, group: &[usize], paths: &mut [Path]) -> Gathered {
+        let mut triangle = [[Vec3::ZERO; LANES]; 3];
+        let mut normals = [[Vec3::ZERO; LANES]; 3];
+        let mut uvs = [[[0.0; LANES]; 2]; 3];
+        let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
+        let (mut direction, mut throughput) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+        let mut u_select = [0.0; LANES];
+        let mut u_light = [[0.0; 2]; LANES];
+        let mut u_direction = [[0.0; LANES]; 2];
+        for lane in 0..LANES {
+            let Some(&index) = group.get(lane) else {
+                u_select[lane] = u_select[0];
+                u_light[lane] = u_light[0];
+                (u_direction[0][lane], u_direction[1][lane]) = (u_direction[0][0], u_direction[1][0]);
+                for corner in 0..3 {
+                    triangle[corner][lane] = triangle[corner][0];
+                    normals[corner][lane] = normals[corner][0];
+                    (uvs[corner][0][lane], uvs[corner][1][lane]) = (uvs[corner][0][0], uvs[corner][1][0]);
+                }
+                (b1[lane], b2[lane], direction[lane], throughput[lane]) = (b1[0], b2[0], direction[0], throughput[0]);
+                continue;
+            };
+            let path = &mut paths[index];
+            self.gather_geometry(path, lane, &mut triangle, &mut normals, &mut uvs);
+            let hit = path.hit.expect("lanes shade hits");
+            (b1[lane], b2[lane]) = (hit.b1, hit.b2);
+            (direction[lane], throughput[lane]) = (path.ray.d, path.throughput.into());
+            u_select[lane] = path.sampler.next_1d();
+            u_light[lane] = path.sampler.next_2d().to_array();
+            path.sampler.next_1d();
+            let u = path.sampler.next_2d();
+            (u_direction[0][lane], u_direction[1][lane]) = (u.x, u.y);
+        }
+        Gathered {
+            triangle: triangle.map(V3::from),
+            normals: normals.map(V3::from),
+            uvs: uvs.map(|uv| uv.map(F32x8)),
+            b1: F32x8(b1),
+            b2: F32x8(b2),
+            direction: V3::from(direction),
+            throughput: V3::from(throughput),
+            u_select,
+            u_light,
+            u_direction: u_direction.map(F32x8),
+        }
+    }
+
+    /// Lane `lane` of the vertices, normals (zero where the mesh has none) and texture
+    /// coordinates of the triangle that `path`'s ray hit.
+    fn gather_geometry(
+        &self,
+        path: &Path,
+        lane: usize,
+        triangle: &mut [[Vec3; LANES]; 3],
+        normals: &mut [[Vec3; LANES]; 3],
+        uvs: &mut [[[f32; LANES]; 2]; 3],
+    ) {
+        let hit = path.hit.expect("lanes shade hits");
+        let vertices = self.scene.geometry.triangle_vertices(hit.primitive as usize);
+        let n = vertices.n.unwrap_or([Vec3::ZERO; 3]);
+        let uv = vertices.uv.unwrap_or(DEFAULT_UVS);
+        for corner in 0..3 {
+            triangle[corner][lane] = vertices.p[corner];
+            normals[corner][lane] = n[corner];
+            uvs[corner][0][lane] = uv[corner].x;
+            uvs[corner][1][lane] = uv[corner].y;
+        }
+    }
+
+    /// The diffuse reflectance of each path of the group at its hit (`s`, with shading frame
+    /// `frame`, seen from `wo`), looked up path by path with its texture footprint.
+    fn reflectances(
+        &self,
+        group: &[usize],
+        paths: &[Path],
+        material: u32,
+        s: &TriangleSurface<F32x8>,
+        frame: &FrameOf<F32x8>,
+        wo: V3<F32x8>,
+    ) -> V3<F32x8> {
+        let scene = self.scene;
+        let mut reflectance = [Vec3::ZERO; LANES];
+        for (lane, &index) in group.iter().enumerate() {
+            let path = &paths[index];
+            let hit = path.hit.expect("lanes shade hits");
+            let mut si = SurfaceInteraction {
+                p: s.p.lane(lane),
+                ng: s.ng.lane(lane),
+                frame: Frame { s: frame.s.lane(lane), t: frame.t.lane(lane), n: frame.n.lane(lane) },
+                uv: Vec2::new(s.uv[0].0[lane], s.uv[1].0[lane]),
+                dpdu: s.dpdu.lane(lane),
+                dpdv: s.dpdv.lane(lane),
+                duv_dx: Vec2::ZERO,
+                duv_dy: Vec2::ZERO,
+                wo: wo.lane(lane),
+                t: hit.t,
+                primitive: hit.primitive,
+            };
+            let ctx = self.texture_context(&mut si, material, path.depth, path.ray.o, &path.diff);
+            if let Bsdf::Diffuse(Diffuse { reflectance: r }) =
+                scene.materials[material as usize].bsdf(&scene.textures, &ctx)
+            {
+                reflectance[lane] = r.into();
+            }
+        }
+        V3::from(reflectance)
+    }
+}
+
+/// Channel by channel product of two colours (red, green, blue as x, y, z).
+#[inline(always)]
+fn tint(a: V3<F32x8>, b: V3<F32x8>) -> V3<F32x8> {
+    V3::new(a.x * b.x, a.y * b.y, a.z * b.z)
+}
+
+/// The rough conductor's colour F(cos_m) times its specular reflectance, channel by channel
+/// ([`crate::bsdf::ConductorFresnel::eval`]).
+#[inline(always)]
+fn conductor_colour(cos_m: F32x8, eta: Rgb, k: Rgb, specular_reflectance: Rgb) -> V3<F32x8> {
+    V3::new(
+        conductor_channel(cos_m, eta.x, k.x, specular_reflectance.x),
+        conductor_channel(cos_m, eta.y, k.y, specular_reflectance.y),
+        conductor_channel(cos_m, eta.z, k.z, specular_reflectance.z),
+    )
+}
+
+/// One channel of [`conductor_colour`] (a function, not a closure: lane code must inline into
+/// [`Isa::run`]'s AVX2 function, and LLVM left the closure out of line).
+#[inline(always)]
+fn conductor_channel(cos_m: F32x8, eta: f32, k: f32, specular_reflectance: f32) -> F32x8 {
+    fresnel_conductor_of(cos_m, F32x8::splat(eta), F32x8::splat(k)) * F32x8::splat(specular_reflectance)
+}
+
+/// The lanes' shading at hits `s` (shading frame `frame`, seen from `wo`): next-event
+/// estimation's light sample with its BSDF value and MIS weight, and the BSDF sample that
+/// continues each path; `reflectance` is the diffuse BSDF's.
+#[inline(always)]
+fn shade(
+    bsdf: LaneBsdf,
+    lights: &crate::light::Lights,
+    gathered: &Gathered,
+    s: &TriangleSurface<F32x8>,
+    frame: &FrameOf<F32x8>,
+    wo: V3<F32x8>,
+    reflectance: V3<F32x8>,
+) -> Shaded {
+    let zero = F32x8::splat(0.0);
+    let wo_local = frame.to_local(wo);
+
+    // Next-event estimation.
+    let light = lights.sample_lanes(s.p, gathered.u_select, gathered.u_light);
+    let wi_local = frame.to_local(light.wi);
+    let (f, bsdf_pdf) = match bsdf {
+        LaneBsdf::RoughConductor { ggx, eta, k, specular_reflectance } => {
+            let terms = Conductor::eval_terms(&ggx, wo_local, wi_local);
+            let f = conductor_colour(terms.cos_m, eta, k, specular_reflectance) * terms.factor;
+            (V3::select(terms.valid, f, V3::splat(0.0)), F32x8::select(terms.valid, terms.pdf, zero))
+        }
+        LaneBsdf::Diffuse => {
+            let (factor, pdf, valid) = Diffuse::eval_terms(wo_local, wi_local);
+            (V3::select(valid, reflectance * factor, V3::splat(0.0)), F32x8::select(valid, pdf, zero))
+        }
+    };
+    let contributes = light.valid & !f.is_zero() & zero.lt(light.pdf);
+    let weight = F32x8::select(light.delta, F32x8::splat(1.0), power_heuristic_of(light.pdf, bsdf_pdf));
+    let contribution = tint(tint(gathered.throughput, f), light.radiance) * (weight / light.pdf);
+    let (to_point, along_point) = shadow_ray_to_of(s.p, s.ng, light.point);
+    let to_infinity = offset_ray_origin_of(s.p, s.ng, light.wi);
+
+    // The BSDF sample that continues the path.
+    let (wi_local, weight, pdf, continues) = match bsdf {
+        LaneBsdf::RoughConductor { ggx, eta, k, specular_reflectance } => {
+            let terms = Conductor::sample_terms(&ggx, wo_local, gathered.u_direction);
+            let colour = conductor_colour(terms.cos_m, eta, k, specular_reflectance);
+            (terms.wi, colour * terms.factor, terms.pdf, zero.lt(wo_local.z) & terms.valid)
+        }
+        LaneBsdf::Diffuse => {
+            let (wi, pdf, valid) = Diffuse::sample_terms(wo_local, gathered.u_direction);
+            (wi, reflectance, pdf, valid)
+        }
+    };
+    let wi = frame.to_world(wi_local);
+    Shaded {
+        contributes,
+        contribution,
+        shadow_origin: V3::select(light.at_infinity, to_infinity, to_point),
+        shadow_direction: V3::select(light.at_infinity, light.wi, along_point),
+        shadow_t_max: F32x8::select(light.at_infinity, F32x8::splat(f32::INFINITY), F32x8::splat(SHADOW_RAY_T_MAX)),
+        continues,
+        weight,
+        pdf,
+        position: s.p,
+        next_origin: offset_ray_origin_of(s.p, s.ng, wi),
+        next_direction: wi,
+    }
+}
