@@ -174,7 +174,7 @@ impl PathTracer<'_> {
     /// The group's triangles, rays and throughputs, and the numbers each path draws for its
     /// light sample and its BSDF sample (the lobe's number too, unused by these BSDFs, so that
     /// the paths draw what one-at-a-time shading draws). Lanes past the group's end repeat its
-    /// first path, without drawing.
+    /// last path, and its first path's numbers, without drawing.
     fn gather(&self, group: &[usize], paths: &mut [Path]) -> Gathered {
         let mut triangle = [[Vec3::ZERO; LANES]; 3];
         let mut normals = [[Vec3::ZERO; LANES]; 3];
@@ -184,29 +184,25 @@ impl PathTracer<'_> {
         let mut u_select = [0.0; LANES];
         let mut u_light = [[0.0; 2]; LANES];
         let mut u_direction = [[0.0; LANES]; 2];
+        let mut primitive = [0; LANES];
         for lane in 0..LANES {
-            let Some(&index) = group.get(lane) else {
-                u_select[lane] = u_select[0];
-                u_light[lane] = u_light[0];
-                (u_direction[0][lane], u_direction[1][lane]) = (u_direction[0][0], u_direction[1][0]);
-                for corner in 0..3 {
-                    triangle[corner][lane] = triangle[corner][0];
-                    normals[corner][lane] = normals[corner][0];
-                    (uvs[corner][0][lane], uvs[corner][1][lane]) = (uvs[corner][0][0], uvs[corner][1][0]);
-                }
-                (b1[lane], b2[lane], direction[lane], throughput[lane]) = (b1[0], b2[0], direction[0], throughput[0]);
-                continue;
-            };
-            let path = &mut paths[index];
-            self.gather_geometry(path, lane, &mut triangle, &mut normals, &mut uvs);
+            let path = &mut paths[group[lane.min(group.len() - 1)]];
             let hit = path.hit.expect("lanes shade hits");
-            (b1[lane], b2[lane]) = (hit.b1, hit.b2);
+            (primitive[lane], b1[lane], b2[lane]) = (hit.primitive, hit.b1, hit.b2);
             (direction[lane], throughput[lane]) = (path.ray.d, path.throughput.into());
+            if lane >= group.len() {
+                (u_select[lane], u_light[lane]) = (u_select[0], u_light[0]);
+                (u_direction[0][lane], u_direction[1][lane]) = (u_direction[0][0], u_direction[1][0]);
+                continue;
+            }
             u_select[lane] = path.sampler.next_1d();
             u_light[lane] = path.sampler.next_2d().to_array();
             path.sampler.next_1d();
             let u = path.sampler.next_2d();
             (u_direction[0][lane], u_direction[1][lane]) = (u.x, u.y);
+        }
+        for lane in 0..LANES {
+            self.gather_triangle(primitive[lane], lane, &mut triangle, &mut normals, &mut uvs);
         }
         Gathered {
             triangle: triangle.map(V3::from),
@@ -223,17 +219,16 @@ impl PathTracer<'_> {
     }
 
     /// Lane `lane` of the vertices, normals (zero where the mesh has none) and texture
-    /// coordinates of the triangle that `path`'s ray hit.
-    fn gather_geometry(
+    /// coordinates of triangle `primitive`.
+    fn gather_triangle(
         &self,
-        path: &Path,
+        primitive: u32,
         lane: usize,
         triangle: &mut [[Vec3; LANES]; 3],
         normals: &mut [[Vec3; LANES]; 3],
         uvs: &mut [[[f32; LANES]; 2]; 3],
     ) {
-        let hit = path.hit.expect("lanes shade hits");
-        let vertices = self.scene.geometry.triangle_vertices(hit.primitive as usize);
+        let vertices = self.scene.geometry.triangle_vertices(primitive as usize);
         let n = vertices.n.unwrap_or([Vec3::ZERO; 3]);
         let uv = vertices.uv.unwrap_or(DEFAULT_UVS);
         for corner in 0..3 {
