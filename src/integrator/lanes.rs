@@ -12,9 +12,9 @@
 //! a time, and hand the results back path by path. Each path draws the numbers that a path
 //! shaded alone draws, in the same order (the light's choice, its point, the lobe, the
 //! direction, Russian roulette), and nothing a lane computes depends on the other lanes, so the
-//! image depends neither on how paths are grouped nor on the instruction set ([`Isa`]). It
-//! differs from one-at-a-time shading only by the lanes' sine and cosine
-//! ([`crate::simd::trig`]), within the last bits of a sampled direction.
+//! image depends neither on how paths are grouped nor on the instruction set
+//! ([`crate::simd::Isa`]). It differs from one-at-a-time shading only by the lanes' sine and
+//! cosine ([`crate::simd::trig`]), within the last bits of a sampled direction.
 
 use super::path::{Path, PathTracer, PreviousVertex, ShadowTest};
 use crate::bsdf::fresnel::fresnel_conductor_of;
@@ -26,12 +26,12 @@ use crate::geometry::{
 };
 use crate::material::Material;
 use crate::sampling::power_heuristic_of;
-use crate::simd::{F32x8, Isa, M32x8, Real, V3};
+use crate::simd::{F32x8, M32x8, Real, V3};
 use crate::texture::{TexCtx, Texture};
 use glam::{Vec2, Vec3};
 
 /// Eight lanes.
-const LANES: usize = 8;
+pub(super) const LANES: usize = 8;
 
 /// How lanes shade a material ([`LaneBsdf::of`]).
 #[derive(Clone, Copy, Debug)]
@@ -108,10 +108,8 @@ impl PathTracer<'_> {
     /// Shade the paths `group` (one to eight indices into `paths`), whose rays hit triangles of
     /// material `material` that lanes shade as `bsdf`: queue their light samples' shadow tests
     /// in `shadow`, continue their rays, and push the paths that go on to `alive`.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn shade_lanes(
         &self,
-        isa: Isa,
         bsdf: LaneBsdf,
         material: u32,
         group: &[usize],
@@ -120,7 +118,7 @@ impl PathTracer<'_> {
         alive: &mut Vec<usize>,
     ) {
         debug_assert!((1..=LANES).contains(&group.len()));
-        let scene = self.scene;
+        let (scene, isa) = (self.scene, self.isa);
         let gathered = self.gather(group, paths);
         let surface = isa.run(
             #[inline(always)]
@@ -201,8 +199,8 @@ impl PathTracer<'_> {
             let u = path.sampler.next_2d();
             (u_direction[0][lane], u_direction[1][lane]) = (u.x, u.y);
         }
-        for lane in 0..LANES {
-            self.gather_triangle(primitive[lane], lane, &mut triangle, &mut normals, &mut uvs);
+        for (lane, &primitive) in primitive.iter().enumerate() {
+            self.gather_triangle(primitive, lane, &mut triangle, &mut normals, &mut uvs);
         }
         Gathered {
             triangle: triangle.map(V3::from),
@@ -297,7 +295,7 @@ fn conductor_colour(cos_m: F32x8, eta: Rgb, k: Rgb, specular_reflectance: Rgb) -
 }
 
 /// One channel of [`conductor_colour`] (a function, not a closure: lane code must inline into
-/// [`Isa::run`]'s AVX2 function, and LLVM left the closure out of line).
+/// [`crate::simd::Isa::run`]'s AVX2 function, and LLVM left the closure out of line).
 #[inline(always)]
 fn conductor_channel(cos_m: F32x8, eta: f32, k: f32, specular_reflectance: f32) -> F32x8 {
     fresnel_conductor_of(cos_m, F32x8::splat(eta), F32x8::splat(k)) * F32x8::splat(specular_reflectance)

@@ -6,14 +6,16 @@
 //! every path has ended. Each path draws its random numbers in the order of a path traced
 //! alone and adds its terms to its radiance in that order (emission, then the light sample of
 //! the vertex, then the next vertex's emission), so that the image does not depend on how the
-//! paths are batched. Stages that see a batch of independent queries and shading points are
-//! where SIMD lanes apply (docs/design-decisions.md, "The wavefront").
+//! paths are batched. The shading stage groups the paths by the material of their hit and
+//! shades those whose material lanes support eight at a time in SIMD lanes
+//! ([`super::lanes`]); the others one at a time (docs/design-decisions.md, "The wavefront",
+//! "Shading in lanes").
 //!
 //! Path length follows Mitsuba 3's count: `max_depth` is the number of path segments, so 1
 //! shows only emitters seen directly and 2 adds direct lighting. Russian roulette starts once
 //! `rr_depth` segments are traced, continuing with probability min(max(throughput) eta^2, 0.95).
 
-use super::lanes::LaneBsdf;
+use super::lanes::{LANES, LaneBsdf};
 use crate::accel::Hit;
 use crate::color::Rgb;
 use crate::geometry::{Frame, Ray, RayDifferential, SurfaceInteraction};
@@ -57,7 +59,7 @@ pub struct PathTracer<'a> {
     /// Per material: how lanes shade it, if they can ([`LaneBsdf::of`]).
     lane_bsdfs: Vec<Option<LaneBsdf>>,
     /// The instruction set of the lanes.
-    isa: Isa,
+    pub(super) isa: Isa,
 }
 
 /// How the previous vertex sampled the current ray, for MIS at the next emitter hit.
@@ -183,8 +185,8 @@ impl<'a> PathTracer<'a> {
             }
             for (material, group) in lane_groups.iter_mut().enumerate() {
                 if let Some(bsdf) = self.lane_bsdfs[material] {
-                    for lanes in group.chunks(8) {
-                        self.shade_lanes(self.isa, bsdf, material as u32, lanes, paths, shadow, alive);
+                    for lanes in group.chunks(LANES) {
+                        self.shade_lanes(bsdf, material as u32, lanes, paths, shadow, alive);
                     }
                 }
                 group.clear();

@@ -137,7 +137,8 @@ impl Lights {
         let (mut chosen, mut sky, mut alone) = ([false; 8], [false; 8], [false; 8]);
         let (mut alone_wi, mut alone_point, mut alone_pdf) = ([Vec3::ZERO; 8], [Vec3::ZERO; 8], [0.0; 8]);
         let (mut alone_valid, mut alone_at_infinity, mut delta) = ([false; 8], [false; 8], [false; 8]);
-        let sky_index = self.count() - 1;
+        // The environment's index, where there is one: after the areas, points and suns.
+        let sky_index = self.area.len() + self.points.len() + self.distant.len();
         for lane in 0..8 {
             let Some(i) = self.choose(u_select[lane]) else { continue };
             chosen[lane] = true;
@@ -218,6 +219,7 @@ impl Lights {
 mod tests {
     use super::*;
     use crate::geometry::Sphere;
+    use crate::simd::Isa;
     use crate::simd::testing::{direction, gather, isas, numbers};
 
     #[test]
@@ -287,5 +289,8 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n > 500), "points, sky and failed samples seen {seen:?} times");
+        // Without lights, no lane has a sample.
+        let none = Isa::Portable.run(|| Lights::default().sample_lanes(gather(direction), [0.5; 8], [[0.5; 2]; 8]));
+        assert_eq!(none.valid, M32x8::from_bools([false; 8]));
     }
 }
