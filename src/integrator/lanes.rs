@@ -99,7 +99,6 @@ struct Shaded {
     continues: M32x8,
     weight: V3<F32x8>,
     pdf: F32x8,
-    position: V3<F32x8>,
     next_origin: V3<F32x8>,
     next_direction: V3<F32x8>,
 }
@@ -120,7 +119,7 @@ impl PathTracer<'_> {
         debug_assert!((1..=LANES).contains(&group.len()));
         let (scene, isa) = (self.scene, self.isa);
         let gathered = self.gather(group, paths);
-        let surface = isa.run(
+        let (s, frame, wo) = isa.run(
             #[inline(always)]
             || {
                 let s =
@@ -128,13 +127,11 @@ impl PathTracer<'_> {
                 (s, FrameOf::from_normal_tangent(s.shading_normal, s.dpdu), -gathered.direction.normalize())
             },
         );
-        let (s, frame, wo) = surface;
-        let material_ref = &scene.materials[material as usize];
         let reflectance = match bsdf {
             LaneBsdf::Diffuse => self.reflectances(group, paths, material, &s, &frame, wo),
             LaneBsdf::RoughConductor { .. } => V3::splat(0.0),
         };
-        let two_sided = material_ref.two_sided;
+        let two_sided = scene.materials[material as usize].two_sided;
         let shaded = isa.run(
             #[inline(always)]
             || {
@@ -160,7 +157,7 @@ impl PathTracer<'_> {
                 continue;
             }
             path.throughput *= Rgb::from(shaded.weight.lane(lane));
-            path.prev = PreviousVertex { p: shaded.position.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
+            path.prev = PreviousVertex { p: s.p.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
             path.ray = Ray::new(shaded.next_origin.lane(lane), shaded.next_direction.lane(lane));
             path.depth += 1;
             if self.survives_roulette(path) {
@@ -359,7 +356,6 @@ fn shade(
         continues,
         weight,
         pdf,
-        position: s.p,
         next_origin: offset_ray_origin_of(s.p, s.ng, wi),
         next_direction: wi,
     }

@@ -50,7 +50,10 @@ impl Isa {
 
     /// `f()`, compiled for this instruction set: everything `f` inlines (lane operations are all
     /// `#[inline(always)]`) is compiled for AVX2 under [`Isa::Avx2`]. Portable where `self` is
-    /// not [`Isa::available`].
+    /// not [`Isa::available`]. A large `f` must itself be marked `#[inline(always)]` where it is
+    /// written (`isa.run(#[inline(always)] || ...)`), and must not call helper closures: LLVM
+    /// leaves a large closure out of line, compiled without AVX2 (`objdump -d` of `with_avx2`
+    /// shows a jump to it).
     #[inline(always)]
     pub fn run<R>(self, f: impl FnOnce() -> R) -> R {
         #[cfg(target_arch = "x86_64")]
