@@ -120,7 +120,7 @@ fn ewa_weight(lut: &[f32; EWA_LUT_SIZE], r2: f32) -> f32 {
 }
 
 /// What a filtered lookup blends: one pyramid's texel, or two pyramids' read at one address
-/// ([`MipMap::lookup_pair`]). The filters are written once for both.
+/// ([`MipMap::gather_pair`]). The filters are written once for both.
 trait Texel:
     Copy + std::ops::Add<Output = Self> + std::ops::Mul<f32, Output = Self> + std::ops::Div<f32, Output = Self>
 {
@@ -160,6 +160,63 @@ impl std::ops::Div<f32> for TexelPair {
     #[inline(always)]
     fn div(self, w: f32) -> Self {
         TexelPair(self.0 / w, self.1 / w)
+    }
+}
+
+/// The texels a filtered lookup reads and how it weighs them ([`MipMap::taps`]), found once and
+/// read from any pyramid of the same layout ([`MipMap::gather`], [`MipMap::same_layout`]): the
+/// tiles of a Mix-Max blend read their priority maps there first, and their exemplar only where
+/// their weight is not 0. An EWA ellipse's texels are found as they are read (they are too many
+/// to list), so that its taps are read again in full: [`MipMap::gather_pair`] reads two pyramids
+/// in one pass.
+#[derive(Clone, Copy, Debug)]
+pub struct Taps {
+    kind: TapsKind,
+    /// Level 0's width and height: a gather from a pyramid of another layout is a bug.
+    #[cfg(debug_assertions)]
+    base: (usize, usize),
+}
+
+impl Taps {
+    /// Whether these are an EWA ellipse's, whose texels every gather finds again.
+    pub fn is_ellipse(&self) -> bool {
+        matches!(self.kind, TapsKind::Ellipse { .. })
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum TapsKind {
+    /// Bilinear at one level.
+    One(BilinearTaps),
+    /// Bilinear at two adjacent levels, the second weighing `t`.
+    Two(BilinearTaps, BilinearTaps, f32),
+    /// EWA over the ellipse at the levels around `lod` (`st` wrapped), its texels found as it is
+    /// read.
+    Ellipse { st: Vec2, dst0: Vec2, dst1: Vec2, lod: f32 },
+    /// The coarsest level's one texel.
+    Coarsest,
+}
+
+/// The four texels of a bilinear lookup at `level` (columns `x`, rows `y`, in range; levels are
+/// narrower than 2^32 texels, [`Bitmap::size_f32`]) and the fractions toward the second of each.
+#[derive(Clone, Copy, Debug)]
+struct BilinearTaps {
+    level: u32,
+    x: [u32; 2],
+    y: [u32; 2],
+    fx: f32,
+    fy: f32,
+}
+
+impl BilinearTaps {
+    /// The bilinear blend of what `texel(level, x, y)` reads at the four texels.
+    #[inline(always)]
+    fn read<T: Texel>(&self, texel: impl Fn(usize, usize, usize) -> T) -> T {
+        let Self { level, x, y, fx, fy } = *self;
+        let texel = |x: u32, y: u32| texel(level as usize, x as usize, y as usize);
+        let top = texel(x[0], y[0]) * (1.0 - fx) + texel(x[1], y[0]) * fx;
+        let bottom = texel(x[0], y[1]) * (1.0 - fx) + texel(x[1], y[1]) * fx;
+        top * (1.0 - fy) + bottom * fy
     }
 }
 
@@ -210,22 +267,20 @@ impl MipMap {
     /// with texel centres at ((i + 0.5) / W, (j + 0.5) / H).
     #[inline]
     pub fn bilinear(&self, level: usize, st: Vec2) -> Vec4 {
-        self.bilinear_of(level, st, |x, y| self.levels[level].pixel(x, y))
+        self.bilinear_taps(level, st).read(|level, x, y| self.levels[level].pixel(x, y))
     }
 
-    /// Bilinear interpolation at `st` of what `texel(x, y)` reads at `level` (x, y in range).
+    /// The texels and fractions of a bilinear lookup of `level` at `st`.
     #[inline(always)]
-    fn bilinear_of<T: Texel>(&self, level: usize, st: Vec2, texel: impl Fn(usize, usize) -> T) -> T {
+    fn bilinear_taps(&self, level: usize, st: Vec2) -> BilinearTaps {
         let l = &self.levels[level];
         let size = l.size_f32();
         let x = st.x * size.x - 0.5;
         let y = st.y * size.y - 0.5;
         let ((x0, fx), (y0, fy)) = (floor_index(x), floor_index(y));
-        let (x0, x1) = (self.index(x0, l.width), self.index(x0 + 1, l.width));
-        let (y0, y1) = (self.index(y0, l.height), self.index(y0 + 1, l.height));
-        let top = texel(x0, y0) * (1.0 - fx) + texel(x1, y0) * fx;
-        let bottom = texel(x0, y1) * (1.0 - fx) + texel(x1, y1) * fx;
-        top * (1.0 - fy) + bottom * fy
+        let x = [self.index(x0, l.width), self.index(x0 + 1, l.width)].map(|x| x as u32);
+        let y = [self.index(y0, l.height), self.index(y0 + 1, l.height)].map(|y| y as u32);
+        BilinearTaps { level: level as u32, x, y, fx, fy }
     }
 
     /// Filtered lookup at `st` with the footprint's image-space derivatives `dst0`, `dst1` (in
@@ -255,54 +310,76 @@ impl MipMap {
     }
 
     /// [`MipMap::lookup`] at `st` with a footprint prepared by [`MipMap::prepare`] (bit for bit).
+    #[inline]
     pub fn lookup_prepared(&self, footprint: &PreparedFootprint, st: Vec2) -> Vec4 {
-        self.filtered(footprint, st, |level, x, y| self.levels[level].pixel(x, y))
+        self.gather(&self.taps(footprint, st))
     }
 
-    /// The lookups of this pyramid and of `other` at once, as two calls of
-    /// [`MipMap::lookup`] give them (bit for bit), for the cost of one lookup's addressing and
-    /// filter weights: two layers of one texture (an exemplar and its Mix-Max priority map).
-    /// None unless the two pyramids' levels have the same sizes and edge handling.
-    pub fn lookup_pair(&self, other: &MipMap, footprint: &PreparedFootprint, st: Vec2) -> Option<(Vec4, Vec4)> {
-        if !self.same_layout(other) {
-            return None;
+    /// Where [`MipMap::lookup_prepared`] reads at `st`: its texels and their weights, to be read
+    /// from this pyramid or any of the same layout by [`MipMap::gather`].
+    #[inline(always)]
+    pub fn taps(&self, footprint: &PreparedFootprint, st: Vec2) -> Taps {
+        // Wrap first so that f32 precision does not degrade far from the origin.
+        let st = if self.clamp { st.clamp(Vec2::ZERO, Vec2::ONE) } else { st - floor2(st) };
+        let kind = match *footprint {
+            PreparedFootprint::Point => TapsKind::One(self.bilinear_taps(0, st)),
+            PreparedFootprint::Levels(lod) => match self.levels_around(lod) {
+                (i, None) => TapsKind::One(self.bilinear_taps(i, st)),
+                (i, Some(t)) => TapsKind::Two(self.bilinear_taps(i, st), self.bilinear_taps(i + 1, st), t),
+            },
+            PreparedFootprint::Ellipse { dst0, dst1, lod } => TapsKind::Ellipse { st, dst0, dst1, lod },
+            PreparedFootprint::Coarsest => TapsKind::Coarsest,
+        };
+        Taps {
+            kind,
+            #[cfg(debug_assertions)]
+            base: (self.levels[0].width, self.levels[0].height),
         }
-        let pair = self.filtered(footprint, st, |level, x, y| {
+    }
+
+    /// The filtered value of this pyramid at `taps`, which [`MipMap::taps`] of a pyramid of the
+    /// same layout ([`MipMap::same_layout`]) gave: that pyramid's lookup's weights applied to
+    /// this one's texels, bit for bit this pyramid's own lookup.
+    #[inline(always)]
+    pub fn gather(&self, taps: &Taps) -> Vec4 {
+        self.gather_with(taps, |level, x, y| self.levels[level].pixel(x, y))
+    }
+
+    /// [`MipMap::gather`] of this pyramid and of `other` (of the same layout) in one pass over
+    /// the taps: for an EWA ellipse, one search of its texels.
+    #[inline(always)]
+    pub fn gather_pair(&self, other: &MipMap, taps: &Taps) -> (Vec4, Vec4) {
+        let pair = self.gather_with(taps, |level, x, y| {
             TexelPair(self.levels[level].pixel(x, y), other.levels[level].pixel(x, y))
         });
-        Some((pair.0, pair.1))
+        (pair.0, pair.1)
+    }
+
+    /// The filtered value at `taps` of what `texel(level, x, y)` reads (x, y in range).
+    #[inline(always)]
+    fn gather_with<T: Texel>(&self, taps: &Taps, texel: impl Fn(usize, usize, usize) -> T) -> T {
+        #[cfg(debug_assertions)]
+        assert_eq!(taps.base, (self.levels[0].width, self.levels[0].height), "taps of another layout");
+        match taps.kind {
+            TapsKind::One(taps) => taps.read(texel),
+            TapsKind::Two(lower, upper, t) => lower.read(&texel) * (1.0 - t) + upper.read(&texel) * t,
+            TapsKind::Ellipse { st, dst0, dst1, lod } => match self.levels_around(lod) {
+                (i, None) => self.ewa_level(i, st, dst0, dst1, &texel),
+                (i, Some(t)) => {
+                    self.ewa_level(i, st, dst0, dst1, &texel) * (1.0 - t)
+                        + self.ewa_level(i + 1, st, dst0, dst1, &texel) * t
+                }
+            },
+            TapsKind::Coarsest => texel(self.levels.len() - 1, 0, 0),
+        }
     }
 
     /// Whether `other`'s levels have the sizes of this one's, with the same edge handling, so
-    /// that one texel address serves both.
-    /// Constant time, as [`MipMap::lookup_pair`] asks it at every lookup: every level's size
-    /// follows from the base's (each halves the one before).
+    /// that one texel address serves both ([`Taps`]). Constant time: every level's size follows
+    /// from the base's (each halves the one before).
     pub fn same_layout(&self, other: &MipMap) -> bool {
         let (a, b) = (&self.levels[0], &other.levels[0]);
         self.clamp == other.clamp && (a.width, a.height) == (b.width, b.height)
-    }
-
-    /// The lookup of [`MipMap::lookup_prepared`], of what `texel(level, x, y)` reads (x, y in
-    /// range).
-    #[inline(always)]
-    fn filtered<T: Texel>(
-        &self,
-        footprint: &PreparedFootprint,
-        st: Vec2,
-        texel: impl Fn(usize, usize, usize) -> T,
-    ) -> T {
-        // Wrap first so that f32 precision does not degrade far from the origin.
-        let st = if self.clamp { st.clamp(Vec2::ZERO, Vec2::ONE) } else { st - floor2(st) };
-        match *footprint {
-            PreparedFootprint::Point => self.bilinear_of(0, st, |x, y| texel(0, x, y)),
-            PreparedFootprint::Levels(lod) => {
-                self.at_level(lod, |level| self.bilinear_of(level, st, |x, y| texel(level, x, y)))
-            }
-            PreparedFootprint::Ellipse { dst0, dst1, lod } => {
-                self.at_level(lod, |level| self.ewa_level(level, st, dst0, dst1, &texel))
-            }
-            PreparedFootprint::Coarsest => texel(self.levels.len() - 1, 0, 0),
-        }
     }
 
     /// The continuous MIP level a lookup with `filter` over the footprint `dst0`, `dst1` reads
@@ -330,13 +407,14 @@ impl MipMap {
         width.max(1e-8).log2().clamp(0.0, (self.levels.len() - 1) as f32)
     }
 
-    /// Blend `f` of the two levels around the continuous level `lod`.
+    /// The level at or below the continuous level `lod`, and the weight of the next one where
+    /// `lod` lies strictly between two levels.
     #[inline(always)]
-    fn at_level<T: Texel>(&self, lod: f32, f: impl Fn(usize) -> T) -> T {
+    fn levels_around(&self, lod: f32) -> (usize, Option<f32>) {
         // lod is not negative (or NaN: level 0, as the cast gives): its floor is its integer part.
         let (i, t) = floor_index(lod);
         let i = i as usize;
-        if t == 0.0 || i + 1 >= self.levels.len() { f(i) } else { f(i) * (1.0 - t) + f(i + 1) * t }
+        (i, (t != 0.0 && i + 1 < self.levels.len()).then_some(t))
     }
 
     /// The EWA ellipse's axes (longer first, the shorter widened to at most `MAX_ANISOTROPY`
@@ -360,8 +438,9 @@ impl MipMap {
     }
 
     /// EWA over one level: Gaussian weights inside the ellipse spanned by `dst0` and `dst1`
-    /// (pbrt-v4 `MIPMap::EWA`).
-    #[inline(always)]
+    /// (pbrt-v4 `MIPMap::EWA`). Not inlined: a loop over tens of texels gains nothing from it,
+    /// and each gather would carry two copies.
+    #[inline(never)]
     fn ewa_level<T: Texel>(
         &self,
         level: usize,
@@ -409,7 +488,7 @@ impl MipMap {
                 }
             }
         }
-        if weights > 0.0 { sum / weights } else { self.bilinear_of(level, st, |x, y| texel(level, x, y)) }
+        if weights > 0.0 { sum / weights } else { self.bilinear_taps(level, st).read(texel) }
     }
 }
 
@@ -488,7 +567,7 @@ mod tests {
     }
 
     #[test]
-    fn a_pair_of_lookups_is_two_lookups_bit_for_bit() {
+    fn taps_gathered_from_two_pyramids_are_their_lookups_bit_for_bit() {
         let noise = |w: usize, h: usize, channels: usize, seed: usize| {
             let mut b = Bitmap::new(w, h, channels);
             for (i, v) in b.data.iter_mut().enumerate() {
@@ -505,22 +584,17 @@ mod tests {
                     let st = Vec2::new(i as f32 * 0.0137 - 2.0, (i * i) as f32 * 0.0031 - 1.0);
                     let d0 = Vec2::from_angle(i as f32) * (0.3 / (1 + i % 50) as f32);
                     let d1 = d0.perp() * 0.4;
-                    let (va, vb) = a.lookup_pair(&b, &a.prepare(filter, d0, d1), st).expect("same layout");
-                    assert_eq!(va, a.lookup(filter, st, d0, d1), "{filter:?} {st}");
-                    assert_eq!(vb, b.lookup(filter, st, d0, d1), "{filter:?} {st}");
+                    let taps = a.taps(&a.prepare(filter, d0, d1), st);
+                    assert_eq!(a.gather(&taps), a.lookup(filter, st, d0, d1), "{filter:?} {st}");
+                    assert_eq!(b.gather(&taps), b.lookup(filter, st, d0, d1), "{filter:?} {st}");
+                    assert_eq!(a.gather_pair(&b, &taps), (a.gather(&taps), b.gather(&taps)), "{filter:?} {st}");
                 }
             }
         }
-        // Pyramids of other sizes or edge handling are not paired.
-        assert!(
-            MipMap::new(noise(8, 8, 1, 0))
-                .lookup_pair(&MipMap::new(noise(8, 4, 1, 0)), &PreparedFootprint::Point, Vec2::ZERO)
-                .is_none()
-        );
-        assert!(
-            MipMap::new(noise(8, 8, 1, 0))
-                .lookup_pair(&MipMap::clamped(noise(8, 8, 1, 0)), &PreparedFootprint::Point, Vec2::ZERO)
-                .is_none()
-        );
+        // Pyramids of other sizes or edge handling do not share taps.
+        let square = MipMap::new(noise(8, 8, 1, 0));
+        assert!(square.same_layout(&MipMap::new(noise(8, 8, 3, 0))));
+        assert!(!square.same_layout(&MipMap::new(noise(8, 4, 1, 0))));
+        assert!(!square.same_layout(&MipMap::clamped(noise(8, 8, 1, 0))));
     }
 }

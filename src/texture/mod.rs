@@ -12,7 +12,7 @@ pub mod tiling_blending;
 
 pub use bake::{BakeFootprint, BakeParams, bake, bake_rect};
 pub use checkerboard::Checkerboard;
-pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap, PreparedFootprint};
+pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap, PreparedFootprint, Taps};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
 
@@ -108,11 +108,12 @@ impl ImageTexture {
         self.mipmap.lookup_prepared(footprint, image_coordinates(uv * self.scale + self.offset))
     }
 
-    /// [`ImageTexture::eval_prepared`] of this image and of `other`, a pyramid of the same layout
-    /// read with this image's filter and mapping, at one addressing (the same values as two
-    /// lookups, bit for bit). None when the layouts differ.
-    pub fn eval_pair(&self, other: &MipMap, uv: Vec2, footprint: &PreparedFootprint) -> Option<(Vec4, Vec4)> {
-        self.mipmap.lookup_pair(other, footprint, image_coordinates(uv * self.scale + self.offset))
+    /// Where [`ImageTexture::eval_prepared`] reads at `uv`: [`MipMap::gather`] of this image's
+    /// pyramid gives its value, and of another pyramid of the same layout read with this image's
+    /// filter and mapping, that pyramid's (both bit for bit as their own lookups).
+    #[inline]
+    pub fn taps(&self, uv: Vec2, footprint: &PreparedFootprint) -> Taps {
+        self.mipmap.taps(footprint, image_coordinates(uv * self.scale + self.offset))
     }
 
     /// The continuous MIP level that [`ImageTexture::eval`] reads at the lookup.

@@ -33,7 +33,7 @@ pub use shift::{cut_shift, fold_seed, shift};
 pub use synthesis::{MAX_LOOKUPS, Synthesis, TileLookup};
 pub use tiling::{MAX_TILES, Tile, Tiling};
 
-use super::{PreparedFootprint, TexCtx, Texture};
+use super::{PreparedFootprint, Taps, TexCtx, Texture};
 use glam::{Vec2, Vec3, Vec4};
 use std::sync::Arc;
 
@@ -42,7 +42,7 @@ use std::sync::Arc;
 enum Exemplar {
     /// Read directly; `mean` for the variance-preserving operator. `paired_priority`: the
     /// exemplar is an image whose Mix-Max priority map reads like it (same layout, filter and
-    /// mapping), so that one addressing reads both ([`ImageTexture::eval_pair`]).
+    /// mapping), so that one addressing reads both ([`ImageTexture::taps`]).
     Plain { texture: Arc<Texture>, mean: Vec4, paired_priority: bool },
     /// Read in Gaussian space (histogram-preserving operator).
     Gaussianized(Box<GaussianizedExemplar>),
@@ -125,7 +125,8 @@ impl TilingBlending {
     }
 
     /// The exemplar `texture`'s values at the tiles' `lookups` and the operator's weights;
-    /// `paired_priority` as in [`Exemplar::Plain`].
+    /// `paired_priority` as in [`Exemplar::Plain`]. The value of a tile of weight 0 may be left
+    /// unread (0).
     fn values_and_weights(
         &self,
         texture: &Arc<Texture>,
@@ -151,14 +152,34 @@ impl TilingBlending {
             }
         };
         if let (true, Blend::MixMax { priority, contrast, lambda }) = (paired_priority, &self.synthesis.blend) {
+            // Each tile's texels are found once: its priorities are read there, then its value
+            // only if the duels left it a weight (often not: a tile that loses every duel by
+            // far weighs exactly 0), which gives the same sum as reading every value. An EWA
+            // ellipse's texels would be searched again: there both are read in one pass.
+            let map = &priority.image().mipmap;
+            let mut unread: [Option<Taps>; MAX_LOOKUPS] = [None; MAX_LOOKUPS];
             let mut moments = [(0.0, 0.0); MAX_LOOKUPS];
             for (i, lookup) in lookups.iter().enumerate() {
-                let (value, p) = image
-                    .eval_pair(&priority.image().mipmap, lookup.ctx.uv, &footprint(&lookup.ctx))
-                    .expect("layouts checked");
-                (values[i], moments[i]) = (value, PriorityMap::moments(p));
+                let taps = image.taps(lookup.ctx.uv, &footprint(&lookup.ctx));
+                let p = if taps.is_ellipse() {
+                    let (value, p) = image.mipmap.gather_pair(map, &taps);
+                    values[i] = value;
+                    p
+                } else {
+                    unread[i] = Some(taps);
+                    map.gather(&taps)
+                };
+                moments[i] = PriorityMap::moments(p);
             }
-            return (values, operators::mix_max_weights(lookups, &moments[..lookups.len()], *contrast, *lambda));
+            let w = operators::mix_max_weights(lookups, &moments[..lookups.len()], *contrast, *lambda);
+            for (i, taps) in unread.iter().enumerate() {
+                if let Some(taps) = taps
+                    && w[i] != 0.0
+                {
+                    values[i] = image.mipmap.gather(taps);
+                }
+            }
+            return (values, w);
         }
         for (value, lookup) in values.iter_mut().zip(lookups) {
             *value = image.eval_prepared(lookup.ctx.uv, &footprint(&lookup.ctx));

@@ -108,7 +108,7 @@ impl PriorityMap {
     }
 
     /// Whether every lookup of `image` reads this map at the same texels with the same filter
-    /// weights, so that one [`ImageTexture::eval_pair`] reads both.
+    /// weights, so that the exemplar's [`ImageTexture::taps`] read both.
     pub(super) fn reads_like(&self, image: &ImageTexture) -> bool {
         let m = &self.map;
         (m.filter, m.scale, m.offset) == (image.filter, image.scale, image.offset)
@@ -178,19 +178,28 @@ impl Blend {
 }
 
 /// P(X > 0) for X normal with mean `difference` and variance `variance`; a step (1/2 at 0) when
-/// the variance is 0.
+/// the variance is 0. Beyond [`DECIDED_SQUARED_SIGMAS`] it is the step without computing Phi,
+/// whose value there rounds to exactly 0 or 1.
 #[inline]
 fn win_probability(difference: f32, variance: f32) -> f32 {
-    if variance > 0.0 {
-        crate::math::normal_cdf_f32(difference / variance.sqrt())
-    } else if difference > 0.0 {
-        1.0
-    } else if difference < 0.0 {
-        0.0
+    if difference * difference > DECIDED_SQUARED_SIGMAS * variance || !(variance > 0.0) {
+        if difference > 0.0 {
+            1.0
+        } else if difference < 0.0 {
+            0.0
+        } else {
+            0.5
+        }
     } else {
-        0.5
+        crate::math::normal_cdf_f32(difference / variance.sqrt())
     }
 }
+
+/// The squared number of standard deviations x^2 beyond which the f32 Phi(x) of
+/// [`crate::math::normal_cdf_f32`] is exactly 0 or 1: there erfc(|x| / sqrt 2), A&S 7.1.26's
+/// poly(t) e^(-x^2 / 2), is below 0.13 e^-20 < 3e-10, far under half an ulp below 1 (2^-25),
+/// so that 1 - erfc rounds to 1. Most duels of a sharp Mix-Max are decided by far.
+const DECIDED_SQUARED_SIGMAS: f32 = 40.0;
 
 /// Mix-Max's weights (see [`Blend::MixMax`]) of the tiles `lookups`, whose priority maps read
 /// `moments` (mean and variance over each tile's footprint): each pair of live tiles duels once,
@@ -244,4 +253,32 @@ pub(super) fn variance_preserving(w: &[f32], values: &[Vec4], mean: Vec4) -> Vec
     let norm = w.iter().map(|w| w * w).sum::<f32>().sqrt();
     let deviation: Vec4 = w.iter().zip(values).map(|(w, v)| (*v - mean) * *w).sum();
     mean + deviation / norm
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::normal_cdf_f32;
+
+    #[test]
+    fn a_duel_decided_by_far_is_the_step_that_phi_rounds_to() {
+        let mut decided = 0;
+        for e in -60..=60 {
+            let variance = 10f32.powf(e as f32 * 0.5);
+            let sigma = variance.sqrt();
+            // From well inside the threshold (6.3 sigmas) to far beyond it, on both sides.
+            for i in 0..400 {
+                let difference = sigma * (5.0 + i as f32 * 0.01) * if i % 2 == 0 { 1.0 } else { -1.0 };
+                let exact = normal_cdf_f32(difference / sigma);
+                assert_eq!(win_probability(difference, variance).to_bits(), exact.to_bits(), "{difference} {variance}");
+                decided += (difference * difference > DECIDED_SQUARED_SIGMAS * variance) as usize;
+            }
+        }
+        assert!(decided > 10_000, "the shortcut was taken {decided} times");
+        // Without spread: a step, 1/2 on a tie.
+        assert_eq!(
+            [win_probability(1e-30, 0.0), win_probability(-1e-30, 0.0), win_probability(0.0, 0.0)],
+            [1.0, 0.0, 0.5]
+        );
+    }
 }
