@@ -44,9 +44,22 @@ impl Bitmap {
     /// The pixel at column `x`, row `y` as RGBA: grey is replicated, missing alpha is 1.
     #[inline(always)]
     pub fn pixel(&self, x: usize, y: usize) -> Vec4 {
-        let i = (y * self.width + x) * self.channels;
-        let d = &self.data[i..i + self.channels];
         match self.channels {
+            1 => self.pixel_of::<1>(x, y),
+            2 => self.pixel_of::<2>(x, y),
+            3 => self.pixel_of::<3>(x, y),
+            _ => self.pixel_of::<4>(x, y),
+        }
+    }
+
+    /// [`Bitmap::pixel`] of a bitmap whose channel count is `C` (4: at least 4), for loops over
+    /// many pixels of one bitmap that match the count once rather than at every pixel.
+    #[inline(always)]
+    pub fn pixel_of<const C: usize>(&self, x: usize, y: usize) -> Vec4 {
+        debug_assert!(self.channels == C || (C == 4 && self.channels > 4));
+        let i = (y * self.width + x) * self.channels;
+        let d = &self.data[i..i + C];
+        match C {
             1 => Vec4::new(d[0], d[0], d[0], 1.0),
             2 => Vec4::new(d[0], d[0], d[0], d[1]),
             3 => Vec4::new(d[0], d[1], d[2], 1.0),

@@ -342,16 +342,32 @@ impl MipMap {
     /// this one's texels, bit for bit this pyramid's own lookup.
     #[inline(always)]
     pub fn gather(&self, taps: &Taps) -> Vec4 {
-        self.gather_with(taps, |level, x, y| self.levels[level].pixel(x, y))
+        // Every level has the base's channels: their count is matched once, not at each texel.
+        match self.levels[0].channels {
+            1 => self.gather_with(taps, |level, x, y| self.levels[level].pixel_of::<1>(x, y)),
+            2 => self.gather_with(taps, |level, x, y| self.levels[level].pixel_of::<2>(x, y)),
+            3 => self.gather_with(taps, |level, x, y| self.levels[level].pixel_of::<3>(x, y)),
+            _ => self.gather_with(taps, |level, x, y| self.levels[level].pixel_of::<4>(x, y)),
+        }
     }
 
     /// [`MipMap::gather`] of this pyramid and of `other` (of the same layout) in one pass over
     /// the taps: for an EWA ellipse, one search of its texels.
     #[inline(always)]
     pub fn gather_pair(&self, other: &MipMap, taps: &Taps) -> (Vec4, Vec4) {
-        let pair = self.gather_with(taps, |level, x, y| {
-            TexelPair(self.levels[level].pixel(x, y), other.levels[level].pixel(x, y))
-        });
+        // The channel counts matched once for the common pairs (an RGB or RGBA exemplar and
+        // its two-channel Mix-Max priority map), at each texel for the others.
+        let pair = match (self.levels[0].channels, other.levels[0].channels) {
+            (3, 2) => self.gather_with(taps, |level, x, y| {
+                TexelPair(self.levels[level].pixel_of::<3>(x, y), other.levels[level].pixel_of::<2>(x, y))
+            }),
+            (4, 2) => self.gather_with(taps, |level, x, y| {
+                TexelPair(self.levels[level].pixel_of::<4>(x, y), other.levels[level].pixel_of::<2>(x, y))
+            }),
+            _ => self.gather_with(taps, |level, x, y| {
+                TexelPair(self.levels[level].pixel(x, y), other.levels[level].pixel(x, y))
+            }),
+        };
         (pair.0, pair.1)
     }
 
@@ -577,6 +593,7 @@ mod tests {
         };
         for (a, b) in [
             (MipMap::new(noise(37, 20, 4, 1)), MipMap::new(noise(37, 20, 2, 2))),
+            (MipMap::new(noise(20, 33, 3, 5)), MipMap::new(noise(20, 33, 2, 6))),
             (MipMap::clamped(noise(16, 16, 3, 3)), MipMap::clamped(noise(16, 16, 1, 4))),
         ] {
             for filter in [Filter::None, Filter::Trilinear, Filter::Ewa] {
