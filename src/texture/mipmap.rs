@@ -583,6 +583,36 @@ mod tests {
     }
 
     #[test]
+    fn bilinear_addresses_are_the_floors_and_wraps_of_the_texel_grid() {
+        // The textbook address: texel centres at (i + 0.5) / n, repeat or clamp.
+        let reference = |m: &MipMap, level: usize, st: Vec2| {
+            let l = m.level(level);
+            let axis = |s: f32, n: usize| {
+                let x = s * n as f32 - 0.5;
+                let i = x.floor() as i64;
+                let at = |i: i64| if m.clamp { i.clamp(0, n as i64 - 1) } else { i.rem_euclid(n as i64) } as u32;
+                ([at(i), at(i + 1)], x - x.floor())
+            };
+            let ((x, fx), (y, fy)) = (axis(st.x, l.width), axis(st.y, l.height));
+            (level as u32, x, y, fx, fy)
+        };
+        for m in [MipMap::new(checker(37)), MipMap::clamped(checker(16)), MipMap::new(Bitmap::new(5, 64, 1))] {
+            let mut points: Vec<Vec2> =
+                (0..2000).map(|i| Vec2::new(i as f32 / 1999.0, (i * i % 1999) as f32 / 1998.0)).collect();
+            points.extend([Vec2::ZERO, Vec2::ONE, Vec2::new(1.0, 0.0)]);
+            for level in 0..m.level_count() {
+                for &st in &points {
+                    let taps = m.bilinear_taps(level, st);
+                    assert_eq!((taps.level, taps.x, taps.y, taps.fx, taps.fy), reference(&m, level, st), "{st}");
+                }
+            }
+            // A NaN coordinate reads texel 0 along its axis, with a NaN fraction.
+            let taps = m.bilinear_taps(0, Vec2::new(f32::NAN, 0.5));
+            assert!(taps.x == [0, 1] && taps.fx.is_nan());
+        }
+    }
+
+    #[test]
     fn taps_gathered_from_two_pyramids_are_their_lookups_bit_for_bit() {
         let noise = |w: usize, h: usize, channels: usize, seed: usize| {
             let mut b = Bitmap::new(w, h, channels);
