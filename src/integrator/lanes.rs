@@ -21,10 +21,10 @@ use crate::bsdf::fresnel::fresnel_conductor_of;
 use crate::bsdf::{Bsdf, Conductor, ConductorFresnel, Diffuse, Ggx};
 use crate::color::Rgb;
 use crate::geometry::{
-    DEFAULT_UVS, Frame, FrameOf, Ray, SHADOW_RAY_T_MAX, SurfaceInteraction, TriangleSurface, offset_ray_origin_of,
-    shadow_ray_to_of, triangle_surface_of,
+    Frame, FrameOf, Ray, SHADOW_RAY_T_MAX, SurfaceInteraction, TriangleSurface, offset_ray_origin_of, shadow_ray_to_of,
+    triangle_surface_of,
 };
-use crate::material::Material;
+use crate::material::{ColorParam, Material, MaterialKind};
 use crate::sampling::power_heuristic_of;
 use crate::simd::{F32x8, M32x8, Real, V3};
 use crate::texture::{TexCtx, Texture};
@@ -48,7 +48,10 @@ pub(super) enum LaneBsdf {
         specular_reflectance: Rgb,
     },
     /// Lambertian reflection, its reflectance looked up path by path.
-    Diffuse,
+    Diffuse {
+        /// The reflectance (a colour or a texture).
+        reflectance: ColorParam,
+    },
 }
 
 impl LaneBsdf {
@@ -58,9 +61,11 @@ impl LaneBsdf {
         if material.normal_map.is_some() || material.texture_frame.is_some() {
             return None;
         }
+        if let MaterialKind::Diffuse { reflectance } = material.kind {
+            return Some(LaneBsdf::Diffuse { reflectance });
+        }
         let anywhere = TexCtx { uv: Vec2::ZERO, duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO, uv_mirrored: None };
         match material.bsdf(textures, &anywhere) {
-            Bsdf::Diffuse(_) => Some(LaneBsdf::Diffuse),
             Bsdf::Conductor(Conductor {
                 ggx: Some(ggx),
                 fresnel: ConductorFresnel::Complex { eta, k },
@@ -128,7 +133,7 @@ impl PathTracer<'_> {
             },
         );
         let reflectance = match bsdf {
-            LaneBsdf::Diffuse => self.reflectances(group, paths, material, &s, &frame, wo),
+            LaneBsdf::Diffuse { reflectance } => self.reflectances(reflectance, group, paths, material, &s, &frame, wo),
             LaneBsdf::RoughConductor { .. } => V3::splat(0.0),
         };
         let two_sided = scene.materials[material as usize].two_sided;
@@ -223,21 +228,23 @@ impl PathTracer<'_> {
         normals: &mut [[Vec3; LANES]; 3],
         uvs: &mut [[[f32; LANES]; 2]; 3],
     ) {
-        let vertices = self.scene.geometry.triangle_vertices(primitive as usize);
-        let n = vertices.n.unwrap_or([Vec3::ZERO; 3]);
-        let uv = vertices.uv.unwrap_or(DEFAULT_UVS);
         for corner in 0..3 {
-            triangle[corner][lane] = vertices.p[corner];
-            normals[corner][lane] = n[corner];
-            uvs[corner][0][lane] = uv[corner].x;
-            uvs[corner][1][lane] = uv[corner].y;
+            let (p, n, uv) = self.scene.geometry.triangle_corner(primitive as usize, corner);
+            triangle[corner][lane] = p;
+            normals[corner][lane] = n;
+            uvs[corner][0][lane] = uv.x;
+            uvs[corner][1][lane] = uv.y;
         }
     }
 
-    /// The diffuse reflectance of each path of the group at its hit (`s`, with shading frame
-    /// `frame`, seen from `wo`), looked up path by path with its texture footprint.
+    /// The diffuse reflectance `reflectance` of each path of the group at its hit (`s`, with
+    /// shading frame `frame`, seen from `wo`), looked up path by path with its texture footprint.
+    /// Whether the UV map is mirrored is taken from the lanes, as are the hit's vectors: reading
+    /// them back from a `SurfaceInteraction` written lane by lane stalls on its stores.
+    #[allow(clippy::too_many_arguments)]
     fn reflectances(
         &self,
+        reflectance: ColorParam,
         group: &[usize],
         paths: &[Path],
         material: u32,
@@ -245,8 +252,11 @@ impl PathTracer<'_> {
         frame: &FrameOf<F32x8>,
         wo: V3<F32x8>,
     ) -> V3<F32x8> {
-        let scene = self.scene;
-        let mut reflectance = [Vec3::ZERO; LANES];
+        let uv_mirrored = self.isa.run(
+            #[inline(always)]
+            || s.dpdu.cross(s.dpdv).dot(s.ng).lt(F32x8::splat(0.0)),
+        );
+        let mut reflectances = [Vec3::ZERO; LANES];
         for (lane, &index) in group.iter().enumerate() {
             let path = &paths[index];
             let hit = path.hit.expect("lanes shade hits");
@@ -263,14 +273,12 @@ impl PathTracer<'_> {
                 t: hit.t,
                 primitive: hit.primitive,
             };
-            let ctx = self.texture_context(&mut si, material, path.depth, path.ray.o, &path.diff);
-            if let Bsdf::Diffuse(Diffuse { reflectance: r }) =
-                scene.materials[material as usize].bsdf(&scene.textures, &ctx)
-            {
-                reflectance[lane] = r.into();
-            }
+            self.set_texture_footprint(&mut si, material, path.depth, path.ray.o, &path.diff);
+            let ctx =
+                TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(uv_mirrored.test(lane)) };
+            reflectances[lane] = reflectance.eval(&self.scene.textures, &ctx).into();
         }
-        V3::from(reflectance)
+        V3::from(reflectances)
     }
 }
 
@@ -323,7 +331,7 @@ fn shade(
             let f = conductor_colour(terms.cos_m, eta, k, specular_reflectance) * terms.factor;
             (V3::select(terms.valid, f, V3::splat(0.0)), F32x8::select(terms.valid, terms.pdf, zero))
         }
-        LaneBsdf::Diffuse => {
+        LaneBsdf::Diffuse { .. } => {
             let (factor, pdf, valid) = Diffuse::eval_terms(wo_local, wi_local);
             (V3::select(valid, reflectance * factor, V3::splat(0.0)), F32x8::select(valid, pdf, zero))
         }
@@ -341,7 +349,7 @@ fn shade(
             let colour = conductor_colour(terms.cos_m, eta, k, specular_reflectance);
             (terms.wi, colour * terms.factor, terms.pdf, zero.lt(wo_local.z) & terms.valid)
         }
-        LaneBsdf::Diffuse => {
+        LaneBsdf::Diffuse { .. } => {
             let (wi, pdf, valid) = Diffuse::sample_terms(wo_local, gathered.u_direction);
             (wi, reflectance, pdf, valid)
         }

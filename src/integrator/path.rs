@@ -333,12 +333,24 @@ impl<'a> PathTracer<'a> {
         o: Vec3,
         diff: &RayDifferential,
     ) -> TexCtx {
+        self.set_texture_footprint(si, material, depth, o, diff);
+        TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) }
+    }
+
+    /// The footprint of [`PathTracer::texture_context`], set in `si`.
+    pub(super) fn set_texture_footprint(
+        &self,
+        si: &mut SurfaceInteraction,
+        material: u32,
+        depth: u32,
+        o: Vec3,
+        diff: &RayDifferential,
+    ) {
         let wants_footprint = self.needs_footprint[material as usize] || (depth == 0 && self.record_footprint);
         if wants_footprint && (depth > 0 || !si.footprint_from_differential(o, diff)) {
             let (dpdx, dpdy) = self.scene.camera.approximate_dp_dxy(si.p, si.ng);
             si.set_footprint(dpdx, dpdy);
         }
-        TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) }
     }
 
     /// Russian roulette for a path that has just been continued: once `rr_depth` segments are

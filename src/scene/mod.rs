@@ -38,7 +38,7 @@ pub fn load_surface(path: &std::path::Path) -> crate::Result<(TriangleMesh, Opti
 
 use crate::accel::{Accel, Hit};
 use crate::camera::Camera;
-use crate::geometry::{Bounds, Ray, Sphere, SurfaceInteraction, TriangleMesh, TriangleVertices};
+use crate::geometry::{Bounds, DEFAULT_UVS, Ray, Sphere, SurfaceInteraction, TriangleMesh, TriangleVertices};
 use crate::light::Lights;
 use crate::material::Material;
 use crate::texture::Texture;
@@ -151,6 +151,20 @@ impl Geometry {
     /// Vertex positions of every triangle, in order: what the accelerator is built over.
     pub fn all_triangle_positions(&self) -> Vec<[Vec3; 3]> {
         (0..self.triangles.len()).map(|t| self.triangle_positions(t)).collect()
+    }
+
+    /// Corner `corner` (0, 1 or 2) of triangle `i`: its position, its shading normal (zero where
+    /// the mesh has none) and its texture coordinates ([`DEFAULT_UVS`] where the mesh has none):
+    /// what [`Geometry::triangle_vertices`] gives at that corner, read without building the
+    /// triangle's arrays (lanes gather corner by corner, and a copy of the arrays stalls on
+    /// their stores).
+    #[inline(always)]
+    pub fn triangle_corner(&self, i: usize, corner: usize) -> (Vec3, Vec3, Vec2) {
+        let v = self.triangles[i][corner] as usize;
+        let shape = &self.shapes[self.triangle_shape[i] as usize];
+        // Meshes without normals or uvs store zeros for them (`Geometry::add`).
+        let uv = if shape.has_uvs { self.uvs[v] } else { DEFAULT_UVS[corner] };
+        (self.positions[v], self.normals[v], uv)
     }
 
     /// All vertex data of triangle `i`.
