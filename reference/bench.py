@@ -14,7 +14,9 @@ Rendering time only, for both: tessera's own figure (`tessera render` prints the
 second of its rendering, after loading), and Mitsuba's `mi.render` timed around (after loading,
 and after one warm-up render that compiles the LLVM kernels). Mitsuba comes from the virtual
 environment of reference/generate.sh (VENV, default ~/.venv-tessera-mitsuba); without it only
-tessera is measured. Builds tessera in release mode first.
+tessera is measured. Builds tessera in release mode first. Prints the machine first (CPU model and
+widest vector instructions): Mitsuba's LLVM variant compiles 16 lanes where the CPU has AVX-512VL
+and 8 where it has AVX2, so a ratio holds for the machine it was measured on.
 """
 import argparse
 import os
@@ -51,6 +53,25 @@ def mitsuba_rate(python, xml, variant, threads):
     return float(run.stdout.split()[1])
 
 
+def machine():
+    """The CPU's model and its widest vector instructions, which decide how many lanes Mitsuba's
+    LLVM variant compiles for (Dr.Jit's LLVM backend: 16 with AVX-512VL, 8 with AVX, 4 with
+    SSE4.2): ratios hold for one machine only."""
+    model, flags = "unknown CPU", set()
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, value = line.partition(":")
+                if key.strip() == "model name" and model == "unknown CPU":
+                    model = value.strip()
+                elif key.strip() == "flags" and not flags:
+                    flags = set(value.split())
+    except OSError:
+        pass
+    widest = next((isa for isa in ("avx512vl", "avx2", "avx", "sse4_2") if isa in flags), "unknown")
+    return f"{model}, {os.cpu_count()} logical CPUs, widest vectors {widest}"
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--rounds", type=int, default=3, help="alternating rounds (the median is printed)")
@@ -73,6 +94,7 @@ def main():
         print(f"bench.py: no Mitsuba virtual environment at {venv} (reference/generate.sh makes one); tessera only")
     out = ROOT / "target/bench"
     out.mkdir(parents=True, exist_ok=True)
+    print(f"machine: {machine()}", flush=True)
 
     for name in names:
         scene = SCENES[name]

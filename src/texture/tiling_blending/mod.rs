@@ -160,16 +160,13 @@ impl TilingBlending {
             let mut unread: [Option<Taps>; MAX_LOOKUPS] = [None; MAX_LOOKUPS];
             let mut moments = [(0.0, 0.0); MAX_LOOKUPS];
             for (i, lookup) in lookups.iter().enumerate() {
-                unread[i] = Some(image.taps(lookup.ctx.uv, &footprint(&lookup.ctx)));
-            }
-            for (i, slot) in unread.iter_mut().enumerate().take(lookups.len()) {
-                let taps = slot.expect("set above");
+                let taps = image.taps(lookup.ctx.uv, &footprint(&lookup.ctx));
                 let p = if taps.is_ellipse() {
                     let (value, p) = image.mipmap.gather_pair(map, &taps);
                     values[i] = value;
-                    *slot = None;
                     p
                 } else {
+                    unread[i] = Some(taps);
                     map.gather(&taps)
                 };
                 moments[i] = PriorityMap::moments(p);
