@@ -251,3 +251,36 @@ impl Scene {
         geometry + self.accel.memory_bytes() + self.textures.iter().map(Texture::memory_bytes).sum::<usize>()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_triangle_corner_is_what_its_vertex_arrays_give_there() {
+        let triangle = |k: f32| TriangleMesh {
+            positions: vec![Vec3::new(k, 0.0, 1.0), Vec3::new(k + 1.0, 0.5, 0.0), Vec3::new(k, 2.0, -1.0)],
+            normals: None,
+            uvs: None,
+            indices: vec![[0, 1, 2], [2, 1, 0]],
+        };
+        let mut geometry = Geometry::default();
+        // With neither normals nor uvs, with both, with uvs only: corners read from each.
+        geometry.add(triangle(0.0), "bare".into(), 0, None);
+        let normals = Some(vec![Vec3::X, Vec3::Y, Vec3::Z]);
+        let uvs = Some(vec![Vec2::new(0.1, 0.2), Vec2::new(0.3, 0.4), Vec2::new(0.5, 0.6)]);
+        geometry.add(TriangleMesh { normals, uvs: uvs.clone(), ..triangle(3.0) }, "full".into(), 0, None);
+        geometry.add(TriangleMesh { uvs, ..triangle(6.0) }, "uvs".into(), 0, None);
+        for i in 0..geometry.triangles.len() {
+            let vertices = geometry.triangle_vertices(i);
+            for corner in 0..3 {
+                let expected = (
+                    vertices.p[corner],
+                    vertices.n.map_or(Vec3::ZERO, |n| n[corner]),
+                    vertices.uv.unwrap_or(DEFAULT_UVS)[corner],
+                );
+                assert_eq!(geometry.triangle_corner(i, corner), expected, "triangle {i}, corner {corner}");
+            }
+        }
+    }
+}
