@@ -16,7 +16,7 @@
 //! ([`crate::simd::Isa`]). It differs from one-at-a-time shading only by the lanes' sine and
 //! cosine ([`crate::simd::trig`]), within the last bits of a sampled direction.
 
-use super::path::{Path, PathTracer, PreviousVertex, ShadowTest};
+use super::path::{Path, PathTracer, PreviousVertex, ShadowTest, lookup_at};
 use crate::bsdf::fresnel::fresnel_conductor_of;
 use crate::bsdf::{Bsdf, Conductor, ConductorFresnel, Diffuse, Ggx};
 use crate::color::Rgb;
@@ -274,8 +274,7 @@ impl PathTracer<'_> {
                 primitive: hit.primitive,
             };
             self.set_texture_footprint(&mut si, material, path.depth, path.ray.o, &path.diff);
-            let ctx =
-                TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(uv_mirrored.test(lane)) };
+            let ctx = lookup_at(&si, uv_mirrored.test(lane));
             reflectances[lane] = reflectance.eval(&self.scene.textures, &ctx).into();
         }
         V3::from(reflectances)

@@ -255,7 +255,8 @@ impl<'a> PathTracer<'a> {
             return false;
         }
 
-        let ctx = self.texture_context(&mut si, shape.material, *depth, ray.o, diff);
+        self.set_texture_footprint(&mut si, shape.material, *depth, ray.o, diff);
+        let ctx = lookup_at(&si, si.uv_mirrored());
         let material = &scene.materials[shape.material as usize];
         let bsdf = material.bsdf(&scene.textures, &ctx);
         // Two-sided materials see the back as the front: mirror the local z axis to the
@@ -321,23 +322,10 @@ impl<'a> PathTracer<'a> {
         self.survives_roulette(path)
     }
 
-    /// The texture lookup's context at `si` on `material`, for a path that has traced `depth`
-    /// segments along rays from `o` (the camera ray's differentials `diff`). The footprint is
-    /// set where a filtered texture needs it: from the camera ray's differentials at the first
-    /// hit, from the camera-based approximation after (pbrt-v4).
-    pub(super) fn texture_context(
-        &self,
-        si: &mut SurfaceInteraction,
-        material: u32,
-        depth: u32,
-        o: Vec3,
-        diff: &RayDifferential,
-    ) -> TexCtx {
-        self.set_texture_footprint(si, material, depth, o, diff);
-        TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) }
-    }
-
-    /// The footprint of [`PathTracer::texture_context`], set in `si`.
+    /// Set the texture footprint of `si` on `material`, for a path that has traced `depth`
+    /// segments along rays from `o` (the camera ray's differentials `diff`), where a filtered
+    /// texture needs it: from the camera ray's differentials at the first hit, from the
+    /// camera-based approximation after (pbrt-v4).
     pub(super) fn set_texture_footprint(
         &self,
         si: &mut SurfaceInteraction,
@@ -368,4 +356,10 @@ impl<'a> PathTracer<'a> {
         // (NaN throughput goes on, as it always has: the film counts the sample as invalid.)
         !(throughput.max_element() <= 0.0)
     }
+}
+
+/// The texture lookup at `si`, with its footprint, on a UV map that is `uv_mirrored` there.
+#[inline]
+pub(super) fn lookup_at(si: &SurfaceInteraction, uv_mirrored: bool) -> TexCtx {
+    TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(uv_mirrored) }
 }

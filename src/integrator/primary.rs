@@ -50,7 +50,7 @@ pub fn primary_lookup(scene: &Scene, camera: &Camera, film: Vec2) -> Option<(Tex
         let (dpdx, dpdy) = camera.approximate_dp_dxy(si.p, si.ng);
         si.set_footprint(dpdx, dpdy);
     }
-    let ctx = TexCtx { uv: si.uv, duv_dx: si.duv_dx, duv_dy: si.duv_dy, uv_mirrored: Some(si.uv_mirrored()) };
+    let ctx = super::path::lookup_at(&si, si.uv_mirrored());
     Some((ctx, si))
 }
 
