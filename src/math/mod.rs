@@ -85,6 +85,27 @@ pub fn normal_cdf_f32(x: f32) -> f32 {
     if x >= 0.0 { 0.5 + 0.5 * erf } else { 0.5 - 0.5 * erf }
 }
 
+/// [`floor`] of each of four lanes (glam's `Vec4`: SSE2 on x86-64), bit for bit. In float
+/// arithmetic alone: x86-64's baseline has no vector conversion to integers that saturates as
+/// Rust's casts do, so LLVM would convert lane by lane. Below 2^23, x + 2^23 (with x's sign)
+/// less 2^23 is x rounded to an integer, and one less where that exceeds x.
+#[inline(always)]
+pub fn floor_x4(x: glam::Vec4) -> glam::Vec4 {
+    let big = glam::Vec4::splat(8_388_608.0);
+    let magic = big.copysign(x);
+    let rounded = (x + magic) - magic;
+    let floor = glam::Vec4::select(rounded.cmpgt(x), rounded - glam::Vec4::ONE, rounded);
+    glam::Vec4::select(x.abs().cmplt(big), floor, x)
+}
+
+/// The integers (|i| < 2^22) in four lanes as i32 lanes, by the bits of i + 1.5 2^23.
+#[inline(always)]
+pub fn int_x4(i: glam::Vec4) -> glam::IVec4 {
+    const MAGIC: f32 = 12_582_912.0;
+    let bits = (i + glam::Vec4::splat(MAGIC)).to_array().map(|v| v.to_bits() as i32);
+    glam::IVec4::from_array(bits) - glam::IVec4::splat(MAGIC.to_bits() as i32)
+}
+
 /// `i` modulo `n` in [0, n): texel indices of images that repeat. Lookups fall at most one
 /// period outside, where this avoids the division.
 #[inline(always)]
@@ -241,6 +262,50 @@ mod tests {
         let (i, fraction) = floor_index(f32::NAN);
         assert_eq!(i, 0);
         assert!(fraction.is_nan());
+    }
+
+    #[test]
+    fn lane_floors_are_the_scalar_floors_bit_for_bit() {
+        let mut xs = vec![
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.499_999_97,
+            -0.499_999_97,
+            -1.0,
+            1e-30,
+            -1e-30,
+            2.999_999,
+            -2.000_001,
+            4_194_303.5,
+            -4_194_303.5,
+            8_388_607.5,
+            -8_388_607.5,
+            1e7 + 0.5,
+            3e9,
+            -3e9,
+            1e38,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        xs.extend((0..4000).map(|i| (i as f32 - 2000.0) * 0.731_3));
+        for x in xs.chunks(4) {
+            let v = glam::Vec4::from_slice(&[x, &[0.0; 4]].concat()[..4]);
+            let (floors, ints) = (floor_x4(v).to_array(), int_x4(floor_x4(v)).to_array());
+            for l in 0..x.len() {
+                assert_eq!(floors[l].to_bits(), floor(x[l]).to_bits(), "{}", x[l]);
+                // Lanes' integers hold below 2^22.
+                if x[l].abs() < 4_194_304.0 {
+                    assert_eq!(ints[l] as i64, floor_index(x[l]).0, "{}", x[l]);
+                }
+            }
+        }
     }
 
     #[test]

@@ -4,8 +4,8 @@
 //! tiles of paper 001, each filtered on its own).
 
 use crate::image::Bitmap;
-use crate::math::{ceil, floor, floor_index, floor2, wrap_index};
-use glam::{Vec2, Vec4};
+use crate::math::{ceil, floor, floor_index, floor_x4, floor2, int_x4, wrap_index};
+use glam::{IVec4, Vec2, Vec4};
 
 /// How an image texture is filtered over the hit's footprint.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
@@ -184,6 +184,109 @@ impl Taps {
     }
 }
 
+/// The taps of four lookups with one footprint, a lookup per lane of glam's `Vec4` (SSE2 on
+/// x86-64): [`MipMap::taps`] of each point, addressed in one pass of lane arithmetic, and
+/// [`MipMap::gather_x4`] filters four lanes at once. The tiles of a tiling and blending are
+/// up to four lookups with one footprint ([`MipMap::taps_x4`] says which footprints).
+#[derive(Clone, Copy, Debug)]
+pub struct TapsX4 {
+    /// The level at or below the footprint's.
+    lower: BilinearTapsX4,
+    /// The level above and its weight, where the footprint lies between two levels.
+    upper: Option<(BilinearTapsX4, f32)>,
+    /// Level 0's width and height, as in [`Taps`].
+    #[cfg(debug_assertions)]
+    base: (usize, usize),
+}
+
+impl TapsX4 {
+    /// Lane `l`'s taps: bit for bit [`MipMap::taps`] at its point.
+    #[inline(always)]
+    pub fn lane(&self, l: usize) -> Taps {
+        let kind = match self.upper {
+            None => TapsKind::One(self.lower.lane(l)),
+            Some((upper, t)) => TapsKind::Two(self.lower.lane(l), upper.lane(l), t),
+        };
+        Taps {
+            kind,
+            #[cfg(debug_assertions)]
+            base: self.base,
+        }
+    }
+}
+
+/// [`BilinearTaps`] of four points at one level, a point per lane.
+#[derive(Clone, Copy, Debug)]
+struct BilinearTapsX4 {
+    level: usize,
+    /// The columns x0 and x1 of each lane.
+    x: [IVec4; 2],
+    /// The rows y0 and y1 of each lane.
+    y: [IVec4; 2],
+    fx: Vec4,
+    fy: Vec4,
+}
+
+impl BilinearTapsX4 {
+    #[inline(always)]
+    fn lane(&self, l: usize) -> BilinearTaps {
+        BilinearTaps {
+            level: self.level as u32,
+            x: self.x.map(|x| x[l] as u32),
+            y: self.y.map(|y| y[l] as u32),
+            fx: self.fx[l],
+            fy: self.fy[l],
+        }
+    }
+
+    /// The bilinear blend, in lanes, of the two channels of `level` (which has two) at each
+    /// lane's four texels.
+    #[inline(always)]
+    fn read_two_channels(&self, level: &Bitmap) -> [Vec4; 2] {
+        let width = IVec4::splat(level.width as i32);
+        let (row0, row1) = (self.y[0] * width, self.y[1] * width);
+        let texels: &[[f32; 2]] = bytemuck::cast_slice(&level.data);
+        let t00 = two_channels_x4(texels, row0 + self.x[0]);
+        let t10 = two_channels_x4(texels, row0 + self.x[1]);
+        let t01 = two_channels_x4(texels, row1 + self.x[0]);
+        let t11 = two_channels_x4(texels, row1 + self.x[1]);
+        let (fx, gx, fy, gy) = (self.fx, Vec4::ONE - self.fx, self.fy, Vec4::ONE - self.fy);
+        let channel = |c: usize| (t00[c] * gx + t10[c] * fx) * gy + (t01[c] * gx + t11[c] * fx) * fy;
+        [channel(0), channel(1)]
+    }
+}
+
+/// Along one axis of a level `n` texels long, the two texels a bilinear lookup at each lane's
+/// wrapped coordinate `st` (in [0, 1], or NaN) reads and the fraction toward the second: as
+/// [`MipMap::bilinear_taps`] finds them (`floor_index`, then `wrap_index`), in float lanes.
+/// The first texel lies in [-1, n - 1] and the second in [0, n] before wrapping (a NaN
+/// coordinate reads texels 0 and 1, with a NaN fraction).
+#[inline(always)]
+fn wrapped_texels_x4(st: Vec4, n: f32) -> ([IVec4; 2], Vec4) {
+    let x = st * n - 0.5;
+    let floor = floor_x4(x);
+    let first = Vec4::select(floor.cmpeq(floor), floor, Vec4::ZERO);
+    let n = Vec4::splat(n);
+    let second = first + Vec4::ONE;
+    let first = Vec4::select(first.cmplt(Vec4::ZERO), first + n, first);
+    let second = Vec4::select(second.cmpge(n), second - n, second);
+    ([int_x4(first), int_x4(second)], x - floor)
+}
+
+/// The two channels of the texels at `offsets` (row-major indices, a texel per lane) of a
+/// two-channel level's `texels`, as a vector per channel.
+#[inline(always)]
+fn two_channels_x4(texels: &[[f32; 2]], offsets: IVec4) -> [Vec4; 2] {
+    // Lane by lane: `array::map` is a call that LLVM leaves out of line here.
+    let (a, b, c, d) = (
+        texels[offsets.x as usize],
+        texels[offsets.y as usize],
+        texels[offsets.z as usize],
+        texels[offsets.w as usize],
+    );
+    [Vec4::new(a[0], b[0], c[0], d[0]), Vec4::new(a[1], b[1], c[1], d[1])]
+}
+
 #[derive(Clone, Copy, Debug)]
 enum TapsKind {
     /// Bilinear at one level.
@@ -334,6 +437,61 @@ impl MipMap {
             kind,
             #[cfg(debug_assertions)]
             base: (self.levels[0].width, self.levels[0].height),
+        }
+    }
+
+    /// [`MipMap::taps`] of four points (image coordinates `s`, `t` by lane) with one footprint,
+    /// in lanes ([`TapsX4`]); None where lanes do not pay: an EWA ellipse's taps, and those of a
+    /// pyramid that clamps at its edges (wrapping alone is written in lanes).
+    #[inline(always)]
+    pub fn taps_x4(&self, footprint: &PreparedFootprint, s: Vec4, t: Vec4) -> Option<TapsX4> {
+        let (lower, upper) = match *footprint {
+            // Lanes hold texel columns and rows below 2^22 ([`int_x4`]), and texel indices
+            // within a level as i32.
+            _ if self.clamp
+                || self.levels[0].width.max(self.levels[0].height) >= 1 << 22
+                || self.levels[0].data.len() > i32::MAX as usize =>
+            {
+                return None;
+            }
+            PreparedFootprint::Point => (0, None),
+            PreparedFootprint::Levels(lod) => self.levels_around(lod),
+            PreparedFootprint::Ellipse { .. } | PreparedFootprint::Coarsest => return None,
+        };
+        // Wrapped first, as `taps` wraps.
+        let (s, t) = (s - floor_x4(s), t - floor_x4(t));
+        Some(TapsX4 {
+            lower: self.bilinear_taps_x4(lower, s, t),
+            upper: upper.map(|w| (self.bilinear_taps_x4(lower + 1, s, t), w)),
+            #[cfg(debug_assertions)]
+            base: (self.levels[0].width, self.levels[0].height),
+        })
+    }
+
+    /// [`MipMap::bilinear_taps`] of four wrapped points, in lanes.
+    #[inline(always)]
+    fn bilinear_taps_x4(&self, level: usize, s: Vec4, t: Vec4) -> BilinearTapsX4 {
+        let l = &self.levels[level];
+        let size = l.size_f32();
+        let (x, fx) = wrapped_texels_x4(s, size.x);
+        let (y, fy) = wrapped_texels_x4(t, size.y);
+        BilinearTapsX4 { level, x, y, fx, fy }
+    }
+
+    /// The two channels of this pyramid (which has two) filtered at each lane of `taps`, a
+    /// vector per channel: bit for bit [`MipMap::gather`] of each [`TapsX4::lane`] (its x and w).
+    #[inline(always)]
+    pub fn gather_two_channels_x4(&self, taps: &TapsX4) -> [Vec4; 2] {
+        #[cfg(debug_assertions)]
+        assert_eq!(taps.base, (self.levels[0].width, self.levels[0].height), "taps of another layout");
+        assert_eq!(self.levels[0].channels, 2, "a two-channel gather of a {}-channel pyramid", self.levels[0].channels);
+        let lower = taps.lower.read_two_channels(&self.levels[taps.lower.level]);
+        match taps.upper {
+            None => lower,
+            Some((upper, t)) => {
+                let upper = upper.read_two_channels(&self.levels[upper.level]);
+                [lower[0] * (1.0 - t) + upper[0] * t, lower[1] * (1.0 - t) + upper[1] * t]
+            }
         }
     }
 
@@ -638,6 +796,44 @@ mod tests {
                 }
             }
         }
+        // Four points' taps in lanes are each point's taps, and their two-channel gather each
+        // point's gather, bit for bit; far and NaN coordinates included.
+        for (a, b) in [
+            (MipMap::new(noise(37, 20, 3, 1)), MipMap::new(noise(37, 20, 2, 2))),
+            (MipMap::new(noise(1, 9, 4, 3)), MipMap::new(noise(1, 9, 2, 4))),
+        ] {
+            for filter in [Filter::None, Filter::Trilinear] {
+                for i in 0..500 {
+                    let st: [Vec2; 4] = std::array::from_fn(|l| {
+                        let j = (4 * i + l) as f32;
+                        match (i + l) % 50 {
+                            0 => Vec2::new(f32::NAN, 0.5),
+                            1 => Vec2::new(1e9 + j, -3e7),
+                            2 => Vec2::new(-1e-9, 1.0),
+                            _ => Vec2::new(j * 0.0137 - 2.0, j * j * 0.0031 - 1.0),
+                        }
+                    });
+                    let d0 = Vec2::from_angle(i as f32) * (0.3 / (1 + i % 50) as f32);
+                    let footprint = a.prepare(filter, d0, d0.perp() * 0.4);
+                    let lanes = |f: fn(Vec2) -> f32| Vec4::new(f(st[0]), f(st[1]), f(st[2]), f(st[3]));
+                    let taps = a.taps_x4(&footprint, lanes(|p| p.x), lanes(|p| p.y)).expect("wrapping pyramids");
+                    let [s, s2] = b.gather_two_channels_x4(&taps);
+                    for (l, &p) in st.iter().enumerate() {
+                        let one = a.taps(&footprint, p);
+                        let bits = |v: Vec4| v.to_array().map(f32::to_bits);
+                        assert_eq!(bits(a.gather(&taps.lane(l))), bits(a.gather(&one)), "{filter:?} {p}");
+                        let v = b.gather(&one);
+                        assert_eq!([s[l].to_bits(), s2[l].to_bits()], [v.x.to_bits(), v.w.to_bits()], "{filter:?} {p}");
+                    }
+                }
+            }
+        }
+        // Lanes wrap only; an ellipse's taps are found as they are read.
+        let clamped = MipMap::clamped(noise(16, 16, 3, 3));
+        assert!(clamped.taps_x4(&PreparedFootprint::Point, Vec4::ZERO, Vec4::ZERO).is_none());
+        let ewa = MipMap::new(noise(16, 16, 3, 3));
+        let ellipse = ewa.prepare(Filter::Ewa, Vec2::new(0.1, 0.0), Vec2::new(0.0, 0.02));
+        assert!(ewa.taps_x4(&ellipse, Vec4::ZERO, Vec4::ZERO).is_none());
         // Pyramids of other sizes or edge handling do not share taps.
         let square = MipMap::new(noise(8, 8, 1, 0));
         assert!(square.same_layout(&MipMap::new(noise(8, 8, 3, 0))));

@@ -12,7 +12,7 @@ pub mod tiling_blending;
 
 pub use bake::{BakeFootprint, BakeParams, bake, bake_rect};
 pub use checkerboard::Checkerboard;
-pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap, PreparedFootprint, Taps};
+pub use mipmap::{EWA_LUT_SIZE, Filter, MAX_ANISOTROPY, MAX_EWA_SPAN, MipMap, PreparedFootprint, Taps, TapsX4};
 pub use quad_tiles::QuadTilesTexture;
 pub use tiling_blending::TilingBlending;
 
@@ -114,6 +114,14 @@ impl ImageTexture {
     #[inline]
     pub fn taps(&self, uv: Vec2, footprint: &PreparedFootprint) -> Taps {
         self.mipmap.taps(footprint, image_coordinates(uv * self.scale + self.offset))
+    }
+
+    /// [`ImageTexture::taps`] at four points with one footprint, in lanes ([`MipMap::taps_x4`]).
+    #[inline]
+    pub fn taps_x4(&self, uv: [Vec2; 4], footprint: &PreparedFootprint) -> Option<TapsX4> {
+        let st = uv.map(|uv| image_coordinates(uv * self.scale + self.offset));
+        let lanes = |f: fn(Vec2) -> f32| Vec4::new(f(st[0]), f(st[1]), f(st[2]), f(st[3]));
+        self.mipmap.taps_x4(footprint, lanes(|st| st.x), lanes(|st| st.y))
     }
 
     /// The continuous MIP level that [`ImageTexture::eval`] reads at the lookup.

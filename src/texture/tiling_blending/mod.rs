@@ -157,6 +157,22 @@ impl TilingBlending {
             // far weighs exactly 0), which gives the same sum as reading every value. An EWA
             // ellipse's texels would be searched again: there both are read in one pass.
             let map = &priority.image().mipmap;
+            // The tiles with one footprint (F read at the point), up to four, are addressed and
+            // their priorities filtered in SSE lanes, a tile per lane.
+            let shared =
+                |l: &TileLookup| (l.ctx.duv_dx, l.ctx.duv_dy) == (lookups[0].ctx.duv_dx, lookups[0].ctx.duv_dy);
+            if (1..=4).contains(&lookups.len()) && lookups.iter().all(shared) {
+                let uv = std::array::from_fn(|i| lookups.get(i).map_or(Vec2::ZERO, |l| l.ctx.uv));
+                if let Some(taps) = image.taps_x4(uv, &footprint(&lookups[0].ctx)) {
+                    let [s, s2] = map.gather_two_channels_x4(&taps);
+                    let moments: [(f32, f32); 4] = std::array::from_fn(|i| PriorityMap::moments(s[i], s2[i]));
+                    let w = operators::mix_max_weights(lookups, &moments[..lookups.len()], *contrast, *lambda);
+                    for i in (0..lookups.len()).filter(|&i| w[i] != 0.0) {
+                        values[i] = image.mipmap.gather(&taps.lane(i));
+                    }
+                    return (values, w);
+                }
+            }
             let mut unread: [Option<Taps>; MAX_LOOKUPS] = [None; MAX_LOOKUPS];
             let mut moments = [(0.0, 0.0); MAX_LOOKUPS];
             for (i, lookup) in lookups.iter().enumerate() {
@@ -169,7 +185,7 @@ impl TilingBlending {
                     unread[i] = Some(taps);
                     map.gather(&taps)
                 };
-                moments[i] = PriorityMap::moments(p);
+                moments[i] = PriorityMap::moments(p.x, p.w);
             }
             let w = operators::mix_max_weights(lookups, &moments[..lookups.len()], *contrast, *lambda);
             for (i, taps) in unread.iter().enumerate() {

@@ -98,13 +98,15 @@ impl PriorityMap {
     /// Mean and variance of the priority over the lookup's footprint.
     #[inline]
     pub(super) fn mean_and_variance(&self, ctx: &TexCtx) -> (f32, f32) {
-        Self::moments(self.map.eval(ctx))
+        let v = self.map.eval(ctx);
+        Self::moments(v.x, v.w)
     }
 
-    /// Mean and variance from a filtered value of the map.
+    /// Mean and variance from the map's two channels filtered over a footprint: the mean of
+    /// s and the mean of s^2.
     #[inline]
-    pub(super) fn moments(v: Vec4) -> (f32, f32) {
-        (v.x, (v.w - v.x * v.x).max(0.0))
+    pub(super) fn moments(mean: f32, mean_square: f32) -> (f32, f32) {
+        (mean, (mean_square - mean * mean).max(0.0))
     }
 
     /// Whether every lookup of `image` reads this map at the same texels with the same filter
