@@ -236,11 +236,11 @@ fn mutate_text(rng: &mut Rng, text: &str) -> Vec<u8> {
             }
             _ => {
                 let quoted: Vec<&str> = text.split('"').skip(1).step_by(2).collect();
-                if let (Some(start), false) = (lines[i].find('"'), quoted.is_empty()) {
-                    if let Some(end) = lines[i][start + 1..].find('"') {
-                        let with = (*rng.pick(&quoted)).to_string();
-                        lines[i].replace_range(start + 1..start + 1 + end, &with);
-                    }
+                if let (Some(start), false) = (lines[i].find('"'), quoted.is_empty())
+                    && let Some(end) = lines[i][start + 1..].find('"')
+                {
+                    let with = (*rng.pick(&quoted)).to_string();
+                    lines[i].replace_range(start + 1..start + 1 + end, &with);
                 }
             }
         }
@@ -571,27 +571,25 @@ fn run_case(seed: &Seed, rng: &mut Rng, dir: &Path) -> Result<(), String> {
     let file = dir.join(&*name);
     std::fs::write(&file, &bytes).unwrap();
     if matches!(seed.kind, Kind::Obj | Kind::Gltf | Kind::Glb) {
-        if let Ok((mesh, _)) = load_surface(&file) {
-            if mesh.uvs.is_some() {
-                let _ = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 32, 0.25);
-            }
+        if let Ok((mesh, _)) = load_surface(&file)
+            && mesh.uvs.is_some()
+        {
+            let _ = deformation_maps(&mesh, &Orientation::Uv, Smoothing::Vertices(1), 32, 0.25);
         }
     } else if seed.kind == Kind::QuadObj {
         let _ = std::fs::remove_file(dir.join("mapped.obj"));
-        if let Ok(mut mesh) = tessera::geometry::load_quad_obj(&file) {
-            if let Ok((topology, _)) = mesh.topology() {
-                let layout = tessera::tiles::TileLayout::new(1, 16).unwrap();
-                let types = tessera::tiles::assign_boundaries(&topology, 1, 0);
-                mesh.uvs = Some(tessera::tiles::texture_coordinates(
-                    &layout,
-                    &tessera::tiles::assign_tiles(&topology, &types),
-                ));
-                if mesh.quads.len() < 10_000 {
-                    mesh = tessera::geometry::catmull_clark(&mesh, &topology);
-                }
-                mesh.write_obj(&dir.join("mapped.obj"), "tiles.png", Some(&mesh.vertex_normals()))
-                    .map_err(|e| format!("writing the mapped mesh: {e}"))?;
+        if let Ok(mut mesh) = tessera::geometry::load_quad_obj(&file)
+            && let Ok((topology, _)) = mesh.topology()
+        {
+            let layout = tessera::tiles::TileLayout::new(1, 16).unwrap();
+            let types = tessera::tiles::assign_boundaries(&topology, 1, 0);
+            mesh.uvs =
+                Some(tessera::tiles::texture_coordinates(&layout, &tessera::tiles::assign_tiles(&topology, &types)));
+            if mesh.quads.len() < 10_000 {
+                mesh = tessera::geometry::catmull_clark(&mesh, &topology);
             }
+            mesh.write_obj(&dir.join("mapped.obj"), "tiles.png", Some(&mesh.vertex_normals()))
+                .map_err(|e| format!("writing the mapped mesh: {e}"))?;
         }
     } else if seed.kind == Kind::PupsPoints {
         if let Ok(points) = tessera::pups::read_points(&file) {

@@ -240,10 +240,12 @@ impl Cuts {
                 uv_length += (left[0].distance(left[1]) + right[0].distance(right[1])) / 2.0;
                 points.push(CutPoint { uv: [left[1], right[1]], s, g });
             }
-            if s > 0.0 && uv_length > 0.0 && embedded.insert(uv_embedding(&points)) {
-                if let Ok(curve) = CutCurve::new(points, s / uv_length) {
-                    curves.push(curve);
-                }
+            if s > 0.0
+                && uv_length > 0.0
+                && embedded.insert(uv_embedding(&points))
+                && let Ok(curve) = CutCurve::new(points, s / uv_length)
+            {
+                curves.push(curve);
             }
         }
         curves

@@ -352,10 +352,10 @@ impl TriangleRaster {
 
 /// Squared distance from `p` to the triangle `t` (in the plane).
 fn distance2_to_triangle(p: Vec2, t: [Vec2; 3]) -> f32 {
-    if let Some(b) = barycentric(p, t) {
-        if b.min_element() >= 0.0 {
-            return 0.0;
-        }
+    if let Some(b) = barycentric(p, t)
+        && b.min_element() >= 0.0
+    {
+        return 0.0;
     }
     (0..3).map(|k| distance2_to_segment(p, t[k], t[(k + 1) % 3])).fold(f32::INFINITY, f32::min)
 }

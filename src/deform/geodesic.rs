@@ -67,12 +67,12 @@ pub fn surface_distances(mesh: &TriangleMesh, sources: &[Vec3]) -> Vec<f32> {
                 let pc = points[c as usize];
                 let mut best = d + points[v as usize].distance(pc);
                 // Across the triangle from v and its third corner w, if w is settled too.
-                if let Some(&w) = t.iter().find(|&&w| w != v && w != c) {
-                    if settled[w as usize] {
-                        let (pv, pw) = (points[v as usize], points[w as usize]);
-                        if let Some(across) = planar_update(pv, pw, pc, d, distance[w as usize]) {
-                            best = best.min(across);
-                        }
+                if let Some(&w) = t.iter().find(|&&w| w != v && w != c)
+                    && settled[w as usize]
+                {
+                    let (pv, pw) = (points[v as usize], points[w as usize]);
+                    if let Some(across) = planar_update(pv, pw, pc, d, distance[w as usize]) {
+                        best = best.min(across);
                     }
                 }
                 if best < distance[c as usize] {

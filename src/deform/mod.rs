@@ -174,14 +174,14 @@ pub fn deformation_maps(
             "{rounds} smoothing rounds or maps {res} over tessera's limits of {max_smoothing} rounds and {max_res} per side"
         ));
     }
-    if let Orientation::PerVertex(tangents) = orientation {
-        if tangents.len() != mesh.positions.len() || !tangents.iter().all(|t| t.is_finite()) {
-            return Err(format!(
-                "{} tangents for {} vertices, or some not finite: one finite tangent per vertex is needed",
-                tangents.len(),
-                mesh.positions.len()
-            ));
-        }
+    if let Orientation::PerVertex(tangents) = orientation
+        && (tangents.len() != mesh.positions.len() || !tangents.iter().all(|t| t.is_finite()))
+    {
+        return Err(format!(
+            "{} tangents for {} vertices, or some not finite: one finite tangent per vertex is needed",
+            tangents.len(),
+            mesh.positions.len()
+        ));
     }
     if !(tile_size > 0.0 && tile_size.is_finite()) {
         return Err(format!("the tile size must be a positive UV length, not {tile_size}"));

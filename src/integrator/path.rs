@@ -283,23 +283,23 @@ impl<'a> PathTracer<'a> {
         // clear.
         let u_light = sampler.next_1d();
         let u_light2 = sampler.next_2d();
-        if !bsdf.is_delta() {
-            if let Some(ls) = lights.sample(si.p, u_light, u_light2) {
-                let wi = frame.to_local(ls.wi);
-                let (f, bsdf_pdf) = bsdf.eval_pdf(wo, wi);
-                let f = f * shading.light_factor(ls.wi);
-                if f != Rgb::ZERO && ls.pdf > 0.0 {
-                    let ray = match ls.point {
-                        Some(q) => si.spawn_ray_to(q),
-                        None => si.spawn_ray(ls.wi),
-                    };
-                    let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf_pdf) };
-                    shadow.push(ShadowTest {
-                        path: index,
-                        ray,
-                        contribution: *throughput * f * ls.radiance * (w / ls.pdf),
-                    });
-                }
+        if !bsdf.is_delta()
+            && let Some(ls) = lights.sample(si.p, u_light, u_light2)
+        {
+            let wi = frame.to_local(ls.wi);
+            let (f, bsdf_pdf) = bsdf.eval_pdf(wo, wi);
+            let f = f * shading.light_factor(ls.wi);
+            if f != Rgb::ZERO && ls.pdf > 0.0 {
+                let ray = match ls.point {
+                    Some(q) => si.spawn_ray_to(q),
+                    None => si.spawn_ray(ls.wi),
+                };
+                let w = if ls.delta { 1.0 } else { power_heuristic(ls.pdf, bsdf_pdf) };
+                shadow.push(ShadowTest {
+                    path: index,
+                    ray,
+                    contribution: *throughput * f * ls.radiance * (w / ls.pdf),
+                });
             }
         }
 

@@ -44,7 +44,7 @@ mod tests {
         use crate::simd::F32x8;
         use crate::simd::testing::isas;
         let special = [0.0, -0.0, 1e-30, 1e30, 3e38, f32::INFINITY, f32::NAN, -2.0];
-        let value = |k: usize| if k % 5 == 0 { special[k / 5 % 8] } else { (k as f32 * 0.37).fract() * 10.0 };
+        let value = |k: usize| if k.is_multiple_of(5) { special[k / 5 % 8] } else { (k as f32 * 0.37).fract() * 10.0 };
         for isa in isas() {
             for chunk in 0..500 {
                 let (a, b) = (|i| value(chunk * 8 + i), |i| value(chunk * 8 + i + 3));

@@ -135,10 +135,10 @@ impl Exporter<'_> {
     /// square at the export's bake resolution (point lookups).
     fn texture(&mut self, id: TextureId, kind: BakeKind, name: &str) -> Result<String> {
         let texture = &self.scene.textures[id.0 as usize];
-        if let Texture::Checkerboard(board) = texture {
-            if let Some(element) = checkerboard(board, kind, name) {
-                return Ok(element);
-            }
+        if let Texture::Checkerboard(board) = texture
+            && let Some(element) = checkerboard(board, kind, name)
+        {
+            return Ok(element);
         }
         let (scale, offset) = match texture {
             Texture::Image(tex) => {

@@ -92,10 +92,10 @@ pub fn import_mitsuba(xml: &Path, out_dir: &Path) -> Result<MitsubaImport> {
 fn with_defaults(doc: &roxmltree::Document, text: &str) -> String {
     let mut defaults: Vec<(&str, &str)> = Vec::new();
     for node in doc.root_element().children().filter(|c| c.has_tag_name("default")) {
-        if let (Some(name), Some(value)) = (node.attribute("name"), node.attribute("value")) {
-            if !defaults.iter().any(|(n, _)| *n == name) {
-                defaults.push((name, value));
-            }
+        if let (Some(name), Some(value)) = (node.attribute("name"), node.attribute("value"))
+            && !defaults.iter().any(|(n, _)| *n == name)
+        {
+            defaults.push((name, value));
         }
     }
     defaults.sort_by_key(|(name, _)| std::cmp::Reverse(name.len()));

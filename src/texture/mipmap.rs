@@ -186,7 +186,7 @@ impl Taps {
 
 /// The taps of four lookups with one footprint, a lookup per lane of glam's `Vec4` (SSE2 on
 /// x86-64): [`MipMap::taps`] of each point, addressed in one pass of lane arithmetic, and
-/// [`MipMap::gather_x4`] filters four lanes at once. The tiles of a tiling and blending are
+/// [`MipMap::gather_two_channels_x4`] filters four lanes at once. The tiles of a tiling and blending are
 /// up to four lookups with one footprint ([`MipMap::taps_x4`] says which footprints).
 #[derive(Clone, Copy, Debug)]
 pub struct TapsX4 {
@@ -245,7 +245,8 @@ impl BilinearTapsX4 {
     fn read_two_channels(&self, level: &Bitmap) -> [Vec4; 2] {
         let width = IVec4::splat(level.width as i32);
         let (row0, row1) = (self.y[0] * width, self.y[1] * width);
-        let texels: &[[f32; 2]] = bytemuck::cast_slice(&level.data);
+        // A texel as one `[f32; 2]`: one bounds check and one load each.
+        let (texels, _) = level.data.as_chunks::<2>();
         let t00 = two_channels_x4(texels, row0 + self.x[0]);
         let t10 = two_channels_x4(texels, row0 + self.x[1]);
         let t01 = two_channels_x4(texels, row1 + self.x[0]);

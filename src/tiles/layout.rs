@@ -67,7 +67,7 @@ impl TileLayout {
         if !(1..=MAX_CONDITIONS).contains(&conditions) {
             return Err(format!("{conditions} boundary conditions: give 1 to {MAX_CONDITIONS}"));
         }
-        if tile_res == 0 || tile_res % GUARD_FRACTION != 0 || tile_res > MAX_TILE_RES {
+        if tile_res == 0 || !tile_res.is_multiple_of(GUARD_FRACTION) || tile_res > MAX_TILE_RES {
             return Err(format!(
                 "tile resolution {tile_res}: give a multiple of {GUARD_FRACTION} up to {MAX_TILE_RES} (the guard band is a \
                  sixteenth of a tile)"
@@ -92,7 +92,7 @@ impl TileLayout {
         let grid = (2 * conditions.min(MAX_CONDITIONS) as usize).pow(2);
         // A cell is 18 sixteenths of a tile whose side is a multiple of 16.
         let unit = grid * (GUARD_FRACTION as usize + 2);
-        if side == 0 || side % unit != 0 {
+        if side == 0 || !side.is_multiple_of(unit) {
             return Err(format!(
                 "a {side} x {side} image is not a tile image of {conditions} condition(s): its side must be {grid} cells of \
                  18/16 of a tile, a multiple of {unit} (e.g. {} for tiles of 256 texels)",
