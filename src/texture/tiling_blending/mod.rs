@@ -270,3 +270,55 @@ fn texture_mean(texture: &Texture) -> Vec4 {
     }
     sum / (n * n) as f32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image::Bitmap;
+    use crate::texture::{Filter, ImageTexture, MipMap};
+    use glam::Mat2;
+
+    /// Mix-Max of a trilinear exemplar takes the lanes' path ([`MipMap::taps_x4`]); its blend is
+    /// the scalar definition's: the operator's weights from the priority map's own lookups,
+    /// times the exemplar's own lookups, bit for bit.
+    #[test]
+    fn mix_max_in_lanes_is_the_scalar_blend_bit_for_bit() {
+        let mut bitmap = Bitmap::new(37, 29, 3);
+        for (i, v) in bitmap.data.iter_mut().enumerate() {
+            *v = ((i * 2_654_435_761) % 1000) as f32 / 1000.0;
+        }
+        let image = ImageTexture {
+            mipmap: Arc::new(MipMap::new(bitmap)),
+            filter: Filter::Trilinear,
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        };
+        let blend = Blend::MixMax { priority: PriorityMap::new(&image), contrast: 4.0, lambda: 0.05 };
+        let exemplar = Arc::new(Texture::Image(image));
+        let rotation = Deformation::Constant(Mat2::from_angle(0.7) * 1.3);
+        for deformation in [None, Some(DeformationField::new(vec![rotation]))] {
+            let synthesis = Synthesis {
+                tiling: Tiling::Hexagonal,
+                tile_size: 0.25,
+                seed: 3,
+                deformation,
+                cuts: None,
+                blend: blend.clone(),
+                inset: false,
+            };
+            let texture = TilingBlending::new(Arc::new(synthesis), exemplar.clone()).expect("an image exemplar");
+            let s = &texture.synthesis;
+            for i in 0..4000 {
+                let uv = Vec2::new(i as f32 * 0.013_7 - 20.0, (i * i % 997) as f32 * 0.007_1);
+                let dx = Vec2::from_angle(i as f32) * (0.2 / (1 + i % 60) as f32);
+                let ctx = TexCtx { uv, duv_dx: dx, duv_dy: dx.perp() * 0.5, uv_mirrored: None };
+                let (lookups, k) = s.lookups(&ctx);
+                let w = s.blend.weights(&lookups[..k], &[Vec4::ZERO; MAX_LOOKUPS][..k], None);
+                let expected: Vec4 =
+                    (0..k).map(|t| if w[t] != 0.0 { exemplar.eval(&lookups[t].ctx) * w[t] } else { Vec4::ZERO }).sum();
+                let bits = |v: Vec4| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(texture.eval(&ctx)), bits(expected), "{uv}");
+            }
+        }
+    }
+}
