@@ -185,9 +185,10 @@ impl Taps {
 }
 
 /// The taps of four lookups with one footprint, a lookup per lane of glam's `Vec4` (SSE2 on
-/// x86-64): [`MipMap::taps`] of each point, addressed in one pass of lane arithmetic, and
-/// [`MipMap::gather_two_channels_x4`] filters four lanes at once. The tiles of a tiling and blending are
-/// up to four lookups with one footprint ([`MipMap::taps_x4`] says which footprints).
+/// x86-64): [`MipMap::taps`] of each point, addressed in one pass of lane arithmetic, which
+/// [`MipMap::gather_two_channels_x4`] filters four lanes at once. The tiles of a tiling and
+/// blending are up to four lookups with one footprint ([`MipMap::taps_x4`] says which
+/// footprints).
 #[derive(Clone, Copy, Debug)]
 pub struct TapsX4 {
     /// The level at or below the footprint's.
