@@ -5,7 +5,7 @@
 //! 1/s times as large, F = R(theta) shows it turned by -theta (DESIGN.md section 3).
 
 use crate::texture::MipMap;
-use glam::{Mat2, Vec2};
+use glam::{Mat2, Vec2, Vec4};
 
 /// One factor of a deformation field.
 #[derive(Clone, Debug)]
@@ -68,11 +68,13 @@ impl Deformation {
 /// overflow.
 pub const MAX_DEFORMATION: f32 = (1 << 20) as f32;
 
-/// `m` with each entry clamped to [-MAX_DEFORMATION, MAX_DEFORMATION], NaN to 0.
+/// `m` with each entry clamped to [-MAX_DEFORMATION, MAX_DEFORMATION], NaN to 0 (the four
+/// entries in one `Vec4`).
 #[inline]
 fn bounded(m: Mat2) -> Mat2 {
-    let clamp = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(-MAX_DEFORMATION, MAX_DEFORMATION) };
-    Mat2::from_cols_array(&m.to_cols_array().map(clamp))
+    let entries = Vec4::from_array(m.to_cols_array());
+    let clamped = entries.clamp(Vec4::splat(-MAX_DEFORMATION), Vec4::splat(MAX_DEFORMATION));
+    Mat2::from_cols_array(&Vec4::select(entries.cmpeq(entries), clamped, Vec4::ZERO).to_array())
 }
 
 /// An F map's value `m` mirrored, M m, where its handedness (det < 0 or not) is not the
@@ -230,6 +232,16 @@ mod tests {
         assert!((scale * Vec2::ONE - Vec2::new(2.0, 3.0) * 0.3f32.exp2()).length() < 1e-5);
         let shear = Deformation::Shear { shear: 0.5, gradient: Vec2::new(0.0, 1.0) }.at(uv);
         assert!((shear * Vec2::new(0.0, 1.0) - Vec2::new(1.2, 1.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn fields_are_bounded_and_nan_free() {
+        let m = Mat2::from_cols_array(&[f32::NAN, f32::INFINITY, -3e30, -0.0]);
+        let field = DeformationField::new(vec![Deformation::Constant(m)]);
+        let bounded = field.at(Vec2::ZERO).to_cols_array();
+        assert_eq!(bounded.map(f32::to_bits), [0.0, MAX_DEFORMATION, -MAX_DEFORMATION, -0.0].map(f32::to_bits));
+        let ordinary = Mat2::from_cols_array(&[0.5, -2.0, 1e5, MAX_DEFORMATION]);
+        assert_eq!(DeformationField::new(vec![Deformation::Constant(ordinary)]).at(Vec2::ONE), ordinary);
     }
 
     #[test]

@@ -100,7 +100,8 @@ impl TilingBlending {
     /// The synthesised value at the lookup (Eq. 1 with the blending operator).
     pub fn eval(&self, ctx: &TexCtx) -> Vec4 {
         let s = &*self.synthesis;
-        let (lookups, k) = s.lookups(ctx);
+        let mut lookups = [TileLookup::default(); MAX_LOOKUPS];
+        let k = s.lookups_into(ctx, &mut lookups);
         let lookups = &lookups[..k];
         let mut values = [Vec4::ZERO; MAX_LOOKUPS];
         match &self.exemplar {
@@ -209,7 +210,8 @@ impl TilingBlending {
     /// section 4). [`TilingBlending::tangent_direction`] says where that frame's x axis lies.
     pub fn eval_normal(&self, ctx: &TexCtx) -> Option<Vec3> {
         let Exemplar::Plain { texture, paired_priority, .. } = &self.exemplar else { return None };
-        let (lookups, k) = self.synthesis.lookups(ctx);
+        let mut lookups = [TileLookup::default(); MAX_LOOKUPS];
+        let k = self.synthesis.lookups_into(ctx, &mut lookups);
         let (values, w) = self.values_and_weights(texture, *paired_priority, &lookups[..k]);
         let total: f32 = w[..k].iter().sum();
         let mut slope = Vec2::ZERO;

@@ -64,13 +64,22 @@ impl Synthesis {
     /// the paving's weights are scaled by 1 - psi and the band's row of tiles along the cut
     /// takes the rest ([`CutBands`]); where two bands overlap, band b weighs
     /// psi_b (1 - psi_other), normalised, so that on a cut only its own row is read.
-    #[inline]
     pub fn lookups(&self, ctx: &TexCtx) -> ([TileLookup; MAX_LOOKUPS], usize) {
+        let mut out = [TileLookup::default(); MAX_LOOKUPS];
+        let count = self.lookups_into(ctx, &mut out);
+        (out, count)
+    }
+
+    /// [`Synthesis::lookups`] written to the first entries of `out`, the caller's array; returns
+    /// how many. Texture lookups use this: an array returned by value was copied, 256 bytes read
+    /// in wide loads from the narrower stores just made, which the store buffer cannot forward,
+    /// and the lookup waited for them (a tenth of a deformed Mix-Max lookup's time).
+    #[inline]
+    pub fn lookups_into(&self, ctx: &TexCtx, out: &mut [TileLookup; MAX_LOOKUPS]) -> usize {
         let k = self.tiles_per_point();
         let tiles = self.tiling.tiles(ctx.uv, self.tile_size);
         let f = self.deformation.as_ref().map(|d| d.at_surface(ctx.uv, ctx.uv_mirrored));
         let chart = self.deformation.as_ref().and_then(|d| d.chart_at(ctx.uv));
-        let mut out = [TileLookup::default(); MAX_LOOKUPS];
         for i in 0..k {
             let tile = &tiles[i];
             let h = shift(tile.vertex, self.seed);
@@ -85,8 +94,7 @@ impl Synthesis {
                 _ => TexCtx { uv: offset + h, uv_mirrored: None, ..*ctx },
             };
         }
-        let count = k + self.band_lookups(ctx, f.unwrap_or(Mat2::IDENTITY), &mut out);
-        (out, count)
+        k + self.band_lookups(ctx, f.unwrap_or(Mat2::IDENTITY), out)
     }
 
     /// Append the cut bands' lookups at `ctx` after the paving's (`f` is F there), reweighting
