@@ -204,6 +204,45 @@ impl Queries<'_> {
         }
     }
 
+    /// The closest hit of each of `rays` into `hits` (of the same length), as
+    /// [`Queries::intersect`] gives it; Embree traces them eight at a time, as packets (the
+    /// four-wide BVH one at a time: packets of rays that diverge measured slower).
+    pub fn intersect_each(&mut self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit per ray");
+        let accel = self.accel;
+        match &accel.backend {
+            #[cfg(feature = "embree")]
+            Backend::Embree(scene) => {
+                for (rays, hits) in rays.chunks(embree::PACKET).zip(hits.chunks_mut(embree::PACKET)) {
+                    scene.intersect8(rays, hits);
+                }
+                if accel.spheres.is_some() {
+                    rays.iter().zip(hits.iter_mut()).for_each(|(r, h)| *h = accel.closer_sphere(r, *h));
+                }
+            }
+            _ => rays.iter().zip(hits.iter_mut()).for_each(|(r, h)| *h = self.intersect(r)),
+        }
+    }
+
+    /// Whether each of `rays` is blocked ([`Queries::occluded`]), into `blocked` (of the same
+    /// length); Embree tests them eight at a time as packets.
+    pub fn occluded_each(&mut self, rays: &[Ray], blocked: &mut [bool]) {
+        assert_eq!(rays.len(), blocked.len(), "one answer per ray");
+        let accel = self.accel;
+        match &accel.backend {
+            #[cfg(feature = "embree")]
+            Backend::Embree(scene) => {
+                for (rays, blocked) in rays.chunks(embree::PACKET).zip(blocked.chunks_mut(embree::PACKET)) {
+                    scene.occluded8(rays, blocked);
+                }
+                if let Some(spheres) = &accel.spheres {
+                    rays.iter().zip(blocked.iter_mut()).for_each(|(r, b)| *b = *b || spheres.occluded(r));
+                }
+            }
+            _ => rays.iter().zip(blocked.iter_mut()).for_each(|(r, b)| *b = self.occluded(r)),
+        }
+    }
+
     /// True when any triangle or sphere lies on the ray with `0 < t < ray.t_max`.
     #[inline]
     pub fn occluded(&mut self, ray: &Ray) -> bool {
@@ -360,7 +399,7 @@ mod tests {
     }
 
     #[test]
-    fn batched_closest_hits_match_single_ray_queries() {
+    fn batched_queries_match_single_ray_queries() {
         // Batches of up to 32 rays: bundles around a few directions (traced as packets, some
         // from spread origins, some with t_max cut short), and stray rays among them.
         let mut rng = Lcg(19);
@@ -387,8 +426,19 @@ mod tests {
                 // Stale answers in the output, which every query must overwrite.
                 let mut hits = vec![Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }); n];
                 accel.intersect_many(&rays, &mut hits);
+                // The wavefront's bounce and shadow queries: Embree's packets of eight.
+                let mut each = hits.clone();
+                each.iter_mut().for_each(|h| *h = Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }));
+                let mut blocked = vec![true; n];
+                accel.queries(|q| {
+                    q.intersect_each(&rays, &mut each);
+                    q.occluded_each(&rays, &mut blocked);
+                });
                 for (i, ray) in rays.iter().enumerate() {
-                    assert_eq!(hits[i], accel.intersect(ray), "{kind:?}: ray {i} of batch {batch}: {ray:?}");
+                    let single = accel.intersect(ray);
+                    assert_eq!(hits[i], single, "{kind:?}: ray {i} of batch {batch}: {ray:?}");
+                    assert_eq!(each[i], single, "{kind:?}: ray {i} of batch {batch} (each): {ray:?}");
+                    assert_eq!(blocked[i], accel.occluded(ray), "{kind:?}: ray {i} of batch {batch} (occluded)");
                     hits_seen += hits[i].is_some() as u32;
                 }
             }

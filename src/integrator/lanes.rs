@@ -259,22 +259,29 @@ impl PathTracer<'_> {
         let mut reflectances = [Vec3::ZERO; LANES];
         for (lane, &index) in group.iter().enumerate() {
             let path = &paths[index];
-            let hit = path.hit.expect("lanes shade hits");
-            let mut si = SurfaceInteraction {
-                p: s.p.lane(lane),
-                ng: s.ng.lane(lane),
-                frame: Frame { s: frame.s.lane(lane), t: frame.t.lane(lane), n: frame.n.lane(lane) },
-                uv: Vec2::new(s.uv[0].0[lane], s.uv[1].0[lane]),
-                dpdu: s.dpdu.lane(lane),
-                dpdv: s.dpdv.lane(lane),
-                duv_dx: Vec2::ZERO,
-                duv_dy: Vec2::ZERO,
-                wo: wo.lane(lane),
-                t: hit.t,
-                primitive: hit.primitive,
+            let uv = Vec2::new(s.uv[0].0[lane], s.uv[1].0[lane]);
+            let mirrored = uv_mirrored.test(lane);
+            let ctx = if self.wants_footprint(material, path.depth) {
+                let hit = path.hit.expect("lanes shade hits");
+                let mut si = SurfaceInteraction {
+                    p: s.p.lane(lane),
+                    ng: s.ng.lane(lane),
+                    frame: Frame { s: frame.s.lane(lane), t: frame.t.lane(lane), n: frame.n.lane(lane) },
+                    uv,
+                    dpdu: s.dpdu.lane(lane),
+                    dpdv: s.dpdv.lane(lane),
+                    duv_dx: Vec2::ZERO,
+                    duv_dy: Vec2::ZERO,
+                    wo: wo.lane(lane),
+                    t: hit.t,
+                    primitive: hit.primitive,
+                };
+                self.set_texture_footprint(&mut si, material, path.depth, path.ray.o, &path.diff);
+                lookup_at(&si, mirrored)
+            } else {
+                // A lookup at the point: no hit point to build.
+                TexCtx { uv, duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO, uv_mirrored: Some(mirrored) }
             };
-            self.set_texture_footprint(&mut si, material, path.depth, path.ray.o, &path.diff);
-            let ctx = lookup_at(&si, uv_mirrored.test(lane));
             reflectances[lane] = reflectance.eval(&self.scene.textures, &ctx).into();
         }
         V3::from(reflectances)

@@ -109,6 +109,9 @@ pub struct WaveBuffers {
     shadow: Vec<ShadowTest>,
     camera_rays: Vec<Ray>,
     camera_hits: Vec<Option<Hit>>,
+    rays: Vec<Ray>,
+    hits: Vec<Option<Hit>>,
+    blocked: Vec<bool>,
 }
 
 impl<'a> PathTracer<'a> {
@@ -156,7 +159,7 @@ impl<'a> PathTracer<'a> {
     /// their camera rays, then shade all at their vertices, test all their shadow rays, trace
     /// all their next rays, and again.
     pub fn trace_wave(&self, paths: &mut [Path], buffers: &mut WaveBuffers) {
-        let WaveBuffers { active, alive, lane_groups, shadow, camera_rays, camera_hits } = buffers;
+        let WaveBuffers { active, alive, lane_groups, shadow, camera_rays, camera_hits, rays, hits, blocked } = buffers;
         lane_groups.resize_with(self.scene.materials.len(), Vec::new);
         // Neighbouring camera rays (a pixel's samples, or neighbouring pixels' in a pass of few
         // samples) are nearly parallel: the accelerator traces them as packets.
@@ -193,13 +196,23 @@ impl<'a> PathTracer<'a> {
             }
             std::mem::swap(active, alive);
             self.scene.accel.queries(|queries| {
-                for test in shadow.iter() {
-                    if !queries.occluded(&test.ray) {
+                rays.clear();
+                rays.extend(shadow.iter().map(|test| test.ray));
+                blocked.clear();
+                blocked.resize(rays.len(), false);
+                queries.occluded_each(rays, blocked);
+                for (test, &blocked) in shadow.iter().zip(blocked.iter()) {
+                    if !blocked {
                         paths[test.path].radiance += test.contribution;
                     }
                 }
-                for &i in active.iter() {
-                    paths[i].hit = queries.intersect(&paths[i].ray);
+                rays.clear();
+                rays.extend(active.iter().map(|&i| paths[i].ray));
+                hits.clear();
+                hits.resize(rays.len(), None);
+                queries.intersect_each(rays, hits);
+                for (&i, &hit) in active.iter().zip(hits.iter()) {
+                    paths[i].hit = hit;
                 }
             });
         }
@@ -322,6 +335,12 @@ impl<'a> PathTracer<'a> {
         self.survives_roulette(path)
     }
 
+    /// Whether a hit on `material` after `depth` segments needs its texture footprint: a
+    /// filtered texture reads it, or the footprint AOV records it.
+    pub(super) fn wants_footprint(&self, material: u32, depth: u32) -> bool {
+        self.needs_footprint[material as usize] || (depth == 0 && self.record_footprint)
+    }
+
     /// Set the texture footprint of `si` on `material`, for a path that has traced `depth`
     /// segments along rays from `o` (the camera ray's differentials `diff`), where a filtered
     /// texture needs it: from the camera ray's differentials at the first hit, from the
@@ -334,8 +353,7 @@ impl<'a> PathTracer<'a> {
         o: Vec3,
         diff: &RayDifferential,
     ) {
-        let wants_footprint = self.needs_footprint[material as usize] || (depth == 0 && self.record_footprint);
-        if wants_footprint && (depth > 0 || !si.footprint_from_differential(o, diff)) {
+        if self.wants_footprint(material, depth) && (depth > 0 || !si.footprint_from_differential(o, diff)) {
             let (dpdx, dpdy) = self.scene.camera.approximate_dp_dxy(si.p, si.ng);
             si.set_footprint(dpdx, dpdy);
         }

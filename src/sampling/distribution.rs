@@ -12,6 +12,11 @@ pub struct Distribution1D {
     cdf: Vec<f32>,
     /// Sum of weights / n (the integral of the step function over [0, 1]).
     integral: f32,
+    /// A guide table (Chen and Asau 1974, "On generating random variates from an empirical
+    /// distribution"): `guide[k]` is the number of `cdf` entries in buckets before `k`
+    /// ([`Distribution1D::bucket`]), n + 1 entries, so that a search for u looks only at the
+    /// entries of u's own bucket.
+    guide: Vec<u32>,
 }
 
 /// A sample of a 1D distribution.
@@ -45,7 +50,24 @@ impl Distribution1D {
         }
         *cdf.last_mut().expect("non-empty") = 1.0;
         let integral = (total / weights.len() as f64) as f32;
-        Distribution1D { weights, cdf, integral }
+        let buckets = weights.len();
+        let mut guide = Vec::with_capacity(buckets + 1);
+        let mut entries = 0;
+        for k in 0..=buckets {
+            while entries < cdf.len() && Self::bucket(cdf[entries], buckets) < k {
+                entries += 1;
+            }
+            guide.push(entries as u32);
+        }
+        Distribution1D { weights, cdf, integral, guide }
+    }
+
+    /// The bucket of a value x among `buckets` (floor(x buckets) in [0, buckets), NaN in 0): a
+    /// non-decreasing function of x, so that every `cdf` entry of an earlier bucket than u's is
+    /// below u, and every entry of a later one above it.
+    #[inline(always)]
+    fn bucket(x: f32, buckets: usize) -> usize {
+        ((x * buckets as f32) as usize).min(buckets - 1)
     }
 
     /// Number of cells.
@@ -77,8 +99,12 @@ impl Distribution1D {
 
     /// Pick a cell with probability proportional to its weight.
     pub fn sample_discrete(&self, u: f32) -> Sample1D {
-        // Largest i with cdf[i] <= u, skipping empty cells.
-        let i = self.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(self.len() - 1);
+        // Largest i with cdf[i] <= u, skipping empty cells: the entries <= u are those of
+        // earlier buckets and the first few of u's own.
+        let k = Self::bucket(u, self.len());
+        let (first, end) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        let at_most_u = first + self.cdf[first..end].partition_point(|&c| c <= u);
+        let i = at_most_u.saturating_sub(1).min(self.len() - 1);
         let pmf = self.pmf(i);
         let u_remapped = if pmf > 0.0 { ((u - self.cdf[i]) / pmf).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.0 };
         Sample1D { index: i, pmf, u_remapped }
@@ -146,6 +172,43 @@ mod tests {
             assert!((*c as f32 / n as f32 - w / 8.0).abs() < 1e-3);
         }
         assert!((d.pdf_cell(2) - 3.0 / 2.0).abs() < 1e-6, "density = weight / mean weight");
+    }
+
+    #[test]
+    fn the_guide_table_finds_the_cell_a_search_of_the_whole_cdf_finds() {
+        // Flat stretches (many entries in one bucket), zero cells, one dominant cell, and
+        // numbers at and around every cdf entry and bucket edge, out of range and NaN.
+        let mut rng = 0x9e37_79b9_u32;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            rng as f32 / u32::MAX as f32
+        };
+        let tables: Vec<Vec<f32>> = vec![
+            vec![1.0],
+            vec![0.0, 0.0, 5.0],
+            (0..300).map(|i| if i == 150 { 1e6 } else { 1e-3 * (i % 7) as f32 }).collect(),
+            (0..257).map(|_| next().powi(8)).collect(),
+            (0..64).map(|i| if i % 3 == 0 { 0.0 } else { 1.0 }).collect(),
+        ];
+        for weights in &tables {
+            let d = Distribution1D::new(weights);
+            let whole = |u: f32| d.cdf.partition_point(|&c| c <= u).saturating_sub(1).min(d.len() - 1);
+            let n = d.len() as f32;
+            let mut us: Vec<f32> = vec![-1.0, -0.0, 0.0, 1.0, 2.0, f32::NAN, f32::INFINITY, f32::MIN_POSITIVE];
+            for &c in &d.cdf {
+                us.extend([c, c.next_up(), c.next_down()]);
+            }
+            for k in 0..=d.len() {
+                let edge = k as f32 / n;
+                us.extend([edge, edge.next_up(), edge.next_down()]);
+            }
+            us.extend((0..20_000).map(|_| next()));
+            for u in us {
+                assert_eq!(d.sample_discrete(u).index, whole(u), "u = {u:e}, {} cells", d.len());
+            }
+        }
     }
 
     #[test]
