@@ -15,9 +15,13 @@ pub struct Distribution1D {
     /// A guide table (Chen and Asau 1974, "On generating random variates from an empirical
     /// distribution"): `guide[k]` is the number of `cdf` entries in buckets before `k`
     /// ([`Distribution1D::bucket`]), n + 1 entries, so that a search for u looks only at the
-    /// entries of u's own bucket.
+    /// entries of u's own bucket. Empty below [`GUIDED_CELLS`] cells, whose whole search is
+    /// shorter than the guide's arithmetic.
     guide: Vec<u32>,
 }
+
+/// The fewest cells that [`Distribution1D`] builds a guide table for.
+const GUIDED_CELLS: usize = 32;
 
 /// A sample of a 1D distribution.
 #[derive(Clone, Copy, Debug)]
@@ -50,16 +54,22 @@ impl Distribution1D {
         }
         *cdf.last_mut().expect("non-empty") = 1.0;
         let integral = (total / weights.len() as f64) as f32;
-        let buckets = weights.len();
-        let mut guide = Vec::with_capacity(buckets + 1);
-        let mut entries = 0;
-        for k in 0..=buckets {
-            while entries < cdf.len() && Self::bucket(cdf[entries], buckets) < k {
-                entries += 1;
-            }
-            guide.push(entries as u32);
-        }
+        let guide = if weights.len() >= GUIDED_CELLS { Self::guide_table(&cdf, weights.len()) } else { Vec::new() };
         Distribution1D { weights, cdf, integral, guide }
+    }
+
+    /// The guide table of `cdf` over `buckets` buckets: per bucket k in 0..=buckets, the number
+    /// of entries in the buckets before k.
+    fn guide_table(cdf: &[f32], buckets: usize) -> Vec<u32> {
+        let mut entries = 0;
+        (0..=buckets)
+            .map(|k| {
+                while entries < cdf.len() && Self::bucket(cdf[entries], buckets) < k {
+                    entries += 1;
+                }
+                entries as u32
+            })
+            .collect()
     }
 
     /// The bucket of a value x among `buckets` (floor(x buckets) in [0, buckets), NaN in 0): a
@@ -98,11 +108,16 @@ impl Distribution1D {
     }
 
     /// Pick a cell with probability proportional to its weight.
+    #[inline]
     pub fn sample_discrete(&self, u: f32) -> Sample1D {
         // Largest i with cdf[i] <= u, skipping empty cells: the entries <= u are those of
         // earlier buckets and the first few of u's own.
-        let k = Self::bucket(u, self.len());
-        let (first, end) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        let (first, end) = if self.guide.is_empty() {
+            (0, self.cdf.len())
+        } else {
+            let k = Self::bucket(u, self.len());
+            (self.guide[k] as usize, self.guide[k + 1] as usize)
+        };
         let at_most_u = first + self.cdf[first..end].partition_point(|&c| c <= u);
         let i = at_most_u.saturating_sub(1).min(self.len() - 1);
         let pmf = self.pmf(i);
@@ -177,7 +192,8 @@ mod tests {
     #[test]
     fn the_guide_table_finds_the_cell_a_search_of_the_whole_cdf_finds() {
         // Flat stretches (many entries in one bucket), zero cells, one dominant cell, and
-        // numbers at and around every cdf entry and bucket edge, out of range and NaN.
+        // numbers at and around every cdf entry and bucket edge, out of range and NaN; the
+        // first two tables are too small for a guide, the others have one.
         let mut rng = 0x9e37_79b9_u32;
         let mut next = || {
             rng ^= rng << 13;
