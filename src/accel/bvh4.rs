@@ -202,7 +202,7 @@ impl CoherentRay {
 }
 
 /// Most rays traced as one packet.
-const PACKET_SIZE: usize = 8;
+const PACKET_SIZE: usize = 32;
 
 /// Rays whose directions are at least this close (cosine of the angle to the group's first ray)
 /// are traced as one packet. A pixel's camera rays are within a fraction of a degree; wider
@@ -305,18 +305,30 @@ impl Bvh4 {
             if group.count_ones() == 1 {
                 let i = group.trailing_zeros() as usize;
                 hits[i] = self.intersect(&rays[i], stack);
+            } else if group.count_ones() <= 8 {
+                // Packets in arrays of their size: each slot's ray is set up, used or not.
+                self.intersect_coherent::<8>(rays, group, hits, stack);
+            } else if group.count_ones() <= 16 {
+                self.intersect_coherent::<16>(rays, group, hits, stack);
             } else {
-                self.intersect_coherent(rays, group, hits, stack);
+                self.intersect_coherent::<PACKET_SIZE>(rays, group, hits, stack);
             }
         }
     }
 
-    /// The closest hits of the rays of `group` (a bit mask into `rays`, at most `PACKET_SIZE`
-    /// set; directions in one octant), traversing once for all. Each ray meets the triangles of
-    /// the leaves it enters with the same test as alone.
-    fn intersect_coherent(&self, rays: &[Ray], group: u32, hits: &mut [Option<Hit>], stack: &mut TraversalStack) {
+    /// The closest hits of the rays of `group` (a bit mask into `rays`, at most `N` set;
+    /// directions in one octant), traversing once for all. Each ray meets the triangles of the
+    /// leaves it enters with the same test as alone.
+    fn intersect_coherent<const N: usize>(
+        &self,
+        rays: &[Ray],
+        group: u32,
+        hits: &mut [Option<Hit>],
+        stack: &mut TraversalStack,
+    ) {
+        debug_assert!(group.count_ones() as usize <= N);
         // Unused slots repeat the first ray.
-        let mut index = [group.trailing_zeros() as usize; PACKET_SIZE];
+        let mut index = [group.trailing_zeros() as usize; N];
         let n = group.count_ones() as usize;
         for (slot, i) in index.iter_mut().zip(set_bits(group)) {
             *slot = i;

@@ -252,6 +252,11 @@ impl PathTracer<'_> {
         frame: &FrameOf<F32x8>,
         wo: V3<F32x8>,
     ) -> V3<F32x8> {
+        if group.iter().all(|&index| !self.wants_footprint(material, paths[index].depth))
+            && let Some(reflectances) = self.image_reflectances_at_points(reflectance, s)
+        {
+            return reflectances;
+        }
         let uv_mirrored = self.isa.run(
             #[inline(always)]
             || s.dpdu.cross(s.dpdv).dot(s.ng).lt(F32x8::splat(0.0)),
@@ -285,6 +290,25 @@ impl PathTracer<'_> {
             reflectances[lane] = reflectance.eval(&self.scene.textures, &ctx).into();
         }
         V3::from(reflectances)
+    }
+
+    /// The diffuse reflectance `reflectance` at the points `s` where it is an image looked up at
+    /// the point (no footprint), four lookups' addresses at a time
+    /// ([`crate::texture::ImageTexture::eval_prepared_x4`]): bit for bit [`ColorParam::eval`]
+    /// there. None for other reflectances, and images that lanes do not serve.
+    fn image_reflectances_at_points(&self, reflectance: ColorParam, s: &TriangleSurface<F32x8>) -> Option<V3<F32x8>> {
+        let ColorParam::Texture { id, scale } = reflectance else { return None };
+        let Texture::Image(image) = &self.scene.textures[id.0 as usize] else { return None };
+        // The footprint every lookup without derivatives has.
+        let footprint = image.prepare(Vec2::ZERO, Vec2::ZERO);
+        let mut reflectances = [Vec3::ZERO; LANES];
+        for (quad, out) in reflectances.chunks_exact_mut(4).enumerate() {
+            let uv = std::array::from_fn(|l| Vec2::new(s.uv[0].0[4 * quad + l], s.uv[1].0[4 * quad + l]));
+            for (out, value) in out.iter_mut().zip(image.eval_prepared_x4(uv, &footprint)?) {
+                *out = (Rgb::from_vec4(value) * scale).into();
+            }
+        }
+        Some(V3::from(reflectances))
     }
 }
 

@@ -124,6 +124,15 @@ impl ImageTexture {
         self.mipmap.taps_x4(footprint, lanes(|st| st.x), lanes(|st| st.y))
     }
 
+    /// [`ImageTexture::eval_prepared`] at four points with one footprint, bit for bit, their
+    /// addresses and weights found in lanes ([`ImageTexture::taps_x4`]); None where lanes do not
+    /// serve the pyramid or the footprint.
+    #[inline]
+    pub fn eval_prepared_x4(&self, uv: [Vec2; 4], footprint: &PreparedFootprint) -> Option<[Vec4; 4]> {
+        let taps = self.taps_x4(uv, footprint)?;
+        Some(std::array::from_fn(|lane| self.mipmap.gather(&taps.lane(lane))))
+    }
+
     /// The continuous MIP level that [`ImageTexture::eval`] reads at the lookup.
     pub fn lod(&self, ctx: &TexCtx) -> f32 {
         self.mipmap.filter_lod(self.filter, self.image_step(ctx.duv_dx), self.image_step(ctx.duv_dy))
@@ -221,6 +230,43 @@ impl Texture {
             Texture::QuadTiles(t) => t.memory_bytes(),
             Texture::Pups(t) => t.texture.memory_bytes(),
             Texture::Checkerboard(_) => 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image::Bitmap;
+
+    #[test]
+    fn image_lookups_in_lanes_are_the_lookups_bit_for_bit() {
+        let mut bitmap = Bitmap::new(23, 14, 3);
+        for (i, v) in bitmap.data.iter_mut().enumerate() {
+            *v = ((i * 2_654_435_761) % 1000) as f32 / 1000.0;
+        }
+        let mipmap = Arc::new(MipMap::new(bitmap));
+        for filter in [Filter::None, Filter::Trilinear] {
+            let image =
+                ImageTexture { mipmap: mipmap.clone(), filter, scale: Vec2::new(3.0, -1.5), offset: Vec2::splat(0.25) };
+            // The footprint of a lookup at the point, which a texture without a filter reads.
+            let footprint = image.prepare(Vec2::ZERO, Vec2::ZERO);
+            for i in 0..300 {
+                let uv: [Vec2; 4] = std::array::from_fn(|l| {
+                    let j = (4 * i + l) as f32;
+                    match (i + l) % 40 {
+                        0 => Vec2::new(f32::NAN, 0.5),
+                        1 => Vec2::new(-2e6 - j, 3e5),
+                        _ => Vec2::new(j * 0.0191 - 3.0, (j * 0.37).sin()),
+                    }
+                });
+                let values = image.eval_prepared_x4(uv, &footprint).expect("a wrapping image");
+                for (&uv, value) in uv.iter().zip(values) {
+                    let ctx = TexCtx { uv, duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO, uv_mirrored: None };
+                    let bits = |v: Vec4| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(value), bits(image.eval(&ctx)), "{filter:?} {uv}");
+                }
+            }
         }
     }
 }
