@@ -270,7 +270,9 @@ impl Camera {
 
     /// The ray through the film point `film` (in pixels), with differentials to the points one
     /// pixel right and one pixel down, scaled by max(1/8, 1/sqrt(spp)); `lens` in [0, 1)^2
-    /// picks the point on a thin lens' aperture (unused by other cameras).
+    /// picks the point on a thin lens' aperture (unused by other cameras). Inlined: returned
+    /// through memory, its fields were read back wider than they were written, a stall a ray.
+    #[inline]
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> (Ray, RayDifferential) {
         let mut o = self.corner_origin + self.origin_step[0] * film.x + self.origin_step[1] * film.y;
         let mut d = self.corner_direction + self.direction_step[0] * film.x + self.direction_step[1] * film.y;
