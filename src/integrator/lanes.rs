@@ -25,7 +25,7 @@ use crate::geometry::{
     triangle_surface_of,
 };
 use crate::material::{ColorParam, Material, MaterialKind};
-use crate::sampling::power_heuristic_of;
+use crate::sampling::{SamplerLanes, power_heuristic_of};
 use crate::simd::{F32x8, M32x8, Real, V3};
 use crate::texture::{TexCtx, Texture};
 use glam::{Vec2, Vec3};
@@ -181,26 +181,25 @@ impl PathTracer<'_> {
         let mut uvs = [[[0.0; LANES]; 2]; 3];
         let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
         let (mut direction, mut throughput) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-        let mut u_select = [0.0; LANES];
-        let mut u_light = [[0.0; 2]; LANES];
-        let mut u_direction = [[0.0; LANES]; 2];
+        let mut draws = SamplerLanes { keys: [0; LANES], dimensions: [0; LANES] };
         let mut primitive = [0; LANES];
         for lane in 0..LANES {
             let path = &mut paths[group[lane.min(group.len() - 1)]];
             let hit = path.hit.expect("lanes shade hits");
             (primitive[lane], b1[lane], b2[lane]) = (hit.primitive, hit.b1, hit.b2);
             (direction[lane], throughput[lane]) = (path.ray.d, path.throughput.into());
-            if lane >= group.len() {
-                (u_select[lane], u_light[lane]) = (u_select[0], u_light[0]);
-                (u_direction[0][lane], u_direction[1][lane]) = (u_direction[0][0], u_direction[1][0]);
-                continue;
-            }
-            u_select[lane] = path.sampler.next_1d();
-            u_light[lane] = path.sampler.next_2d().to_array();
-            path.sampler.next_1d();
-            let u = path.sampler.next_2d();
-            (u_direction[0][lane], u_direction[1][lane]) = (u.x, u.y);
+            // The light's choice, its point, the lobe, the direction: four draws.
+            (draws.keys[lane], draws.dimensions[lane]) =
+                if lane < group.len() { path.sampler.reserve(4) } else { (draws.keys[0], draws.dimensions[0]) };
         }
+        let (u_select, u_light, u_direction) = self.isa.run(
+            #[inline(always)]
+            || {
+                let [light_x, light_y] = draws.draw_2d(1);
+                let u_light: [[f32; 2]; LANES] = std::array::from_fn(|lane| [light_x[lane], light_y[lane]]);
+                (draws.draw_1d(0), u_light, draws.draw_2d(3))
+            },
+        );
         for (lane, &primitive) in primitive.iter().enumerate() {
             self.gather_triangle(primitive, lane, &mut triangle, &mut normals, &mut uvs);
         }

@@ -5,6 +5,7 @@ mod rng;
 pub mod warp;
 
 pub use distribution::{Distribution1D, Distribution2D};
+pub(crate) use rng::SamplerLanes;
 pub(crate) use rng::mix64;
 pub use rng::{PixelKey, Sampler};
 

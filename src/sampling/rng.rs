@@ -51,7 +51,7 @@ impl Sampler {
     /// The next draw's 64 hashed bits.
     #[inline]
     fn next_bits(&mut self) -> u64 {
-        let bits = mix64(self.key ^ (self.dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let bits = draw_bits(self.key, self.dimension);
         self.dimension += 1;
         bits
     }
@@ -59,8 +59,7 @@ impl Sampler {
     /// The next uniform number in [0, 1).
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
-        // The top 24 bits make every float in [0, 1) with spacing 2^-24 equally likely.
-        unit_from_24_bits(self.next_bits() >> 40)
+        first_unit(self.next_bits())
     }
 
     /// The next two uniform numbers, from the top and the next 24 bits of one hash: the
@@ -68,14 +67,79 @@ impl Sampler {
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
         let bits = self.next_bits();
-        Vec2::new(unit_from_24_bits(bits >> 40), unit_from_24_bits((bits >> 16) & 0xff_ffff))
+        Vec2::new(first_unit(bits), second_unit(bits))
+    }
+
+    /// The stream's key and next dimension, for `draws` draws taken in lanes
+    /// ([`SamplerLanes`]); the sampler moves past them, as if it had drawn them.
+    #[inline]
+    pub(crate) fn reserve(&mut self, draws: u32) -> (u64, u32) {
+        let start = (self.key, self.dimension);
+        self.dimension += draws;
+        start
     }
 }
 
-/// A 24-bit integer as a float in [0, 1) (exact: floats hold 24-bit integers).
+/// The draws of eight samplers in lanes, bit for bit what [`Sampler::next_1d`] and
+/// [`Sampler::next_2d`] give: the hashes are computed eight at a time, in 64-bit lanes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SamplerLanes {
+    /// Per lane, the sampler's key and the dimension of its first reserved draw
+    /// ([`Sampler::reserve`]).
+    pub(crate) keys: [u64; 8],
+    pub(crate) dimensions: [u32; 8],
+}
+
+impl SamplerLanes {
+    /// The hashed bits of each lane's reserved draw `offset` (0 for the first).
+    #[inline(always)]
+    fn bits(&self, offset: u32) -> [u64; 8] {
+        let mut bits = [0; 8];
+        for (lane, out) in bits.iter_mut().enumerate() {
+            *out = draw_bits(self.keys[lane], self.dimensions[lane] + offset);
+        }
+        bits
+    }
+
+    /// Each lane's reserved draw `offset` as [`Sampler::next_1d`] gives it.
+    #[inline(always)]
+    pub(crate) fn draw_1d(&self, offset: u32) -> [f32; 8] {
+        self.bits(offset).map(first_unit)
+    }
+
+    /// Each lane's reserved draw `offset` as [`Sampler::next_2d`] gives it: the first numbers,
+    /// then the second.
+    #[inline(always)]
+    pub(crate) fn draw_2d(&self, offset: u32) -> [[f32; 8]; 2] {
+        let bits = self.bits(offset);
+        [bits.map(first_unit), bits.map(second_unit)]
+    }
+}
+
+/// The 64 hashed bits of the draw of dimension `dimension` (0 for the first) of stream `key`.
+#[inline(always)]
+fn draw_bits(key: u64, dimension: u32) -> u64 {
+    mix64(key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
+/// A draw's first number in [0, 1): its top 24 bits, which make every float in [0, 1) with
+/// spacing 2^-24 equally likely.
+#[inline(always)]
+fn first_unit(bits: u64) -> f32 {
+    unit_from_24_bits(bits >> 40)
+}
+
+/// A draw's second number in [0, 1) (for [`Sampler::next_2d`]): its next 24 bits.
+#[inline(always)]
+fn second_unit(bits: u64) -> f32 {
+    unit_from_24_bits((bits >> 16) & 0xff_ffff)
+}
+
+/// A 24-bit integer as a float in [0, 1) (exact: floats hold 24-bit integers; converted from
+/// i32, which lanes convert in one instruction).
 #[inline(always)]
 fn unit_from_24_bits(bits: u64) -> f32 {
-    bits as f32 * (1.0 / 16_777_216.0)
+    bits as i32 as f32 * (1.0 / 16_777_216.0)
 }
 
 #[cfg(test)]
@@ -98,6 +162,41 @@ mod tests {
             (0..8).map(|_| s.next_1d()).collect()
         };
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn draws_in_lanes_are_the_samplers_draws_bit_for_bit() {
+        use crate::simd::Isa;
+        for isa in [Isa::Avx2, Isa::Portable].into_iter().filter(|isa| isa.available()) {
+            for trial in 0..300u64 {
+                // Eight streams at different dimensions.
+                let samplers: [Sampler; 8] = std::array::from_fn(|lane| {
+                    let mut s = Sampler::new(trial, lane as u64 * 7919 + trial * 3, (lane as u32 * 13) ^ trial as u32);
+                    (0..(lane + trial as usize) % 6).for_each(|_| _ = s.next_1d());
+                    s
+                });
+                let mut lanes = SamplerLanes { keys: [0; 8], dimensions: [0; 8] };
+                for (lane, sampler) in samplers.iter().enumerate() {
+                    let mut reserving = sampler.clone();
+                    (lanes.keys[lane], lanes.dimensions[lane]) = reserving.reserve(3);
+                    // Past the reserved draws, the stream goes on where three draws leave it.
+                    let mut drawing = sampler.clone();
+                    (0..3).for_each(|_| _ = drawing.next_1d());
+                    assert_eq!(reserving.next_1d().to_bits(), drawing.next_1d().to_bits());
+                }
+                let (first, second, third) = isa.run(|| (lanes.draw_1d(0), lanes.draw_2d(1), lanes.draw_1d(2)));
+                for (lane, sampler) in samplers.iter().enumerate() {
+                    let mut s = sampler.clone();
+                    assert_eq!(s.next_1d().to_bits(), first[lane].to_bits(), "{isa:?}, lane {lane}");
+                    let pair = s.next_2d();
+                    assert_eq!(
+                        [pair.x.to_bits(), pair.y.to_bits()],
+                        [second[0][lane].to_bits(), second[1][lane].to_bits()]
+                    );
+                    assert_eq!(s.next_1d().to_bits(), third[lane].to_bits(), "{isa:?}, lane {lane}");
+                }
+            }
+        }
     }
 
     #[test]
