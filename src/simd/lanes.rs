@@ -164,7 +164,7 @@ impl M32x8 {
 
     /// Whether lane `i` is set.
     #[inline(always)]
-    pub fn test(self, i: usize) -> bool {
+    pub fn test(&self, i: usize) -> bool {
         self.0[i] != 0
     }
 }

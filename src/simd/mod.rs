@@ -283,9 +283,10 @@ impl From<[glam::Vec3; 8]> for V3<F32x8> {
 }
 
 impl V3<F32x8> {
-    /// Lane `i`.
+    /// Lane `i` (read in place: taken by value with a run-time index, the three vectors were
+    /// copied to the stack first, at every call).
     #[inline(always)]
-    pub fn lane(self, i: usize) -> glam::Vec3 {
+    pub fn lane(&self, i: usize) -> glam::Vec3 {
         glam::Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
     }
 }
