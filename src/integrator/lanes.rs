@@ -28,7 +28,7 @@ use crate::material::{ColorParam, Material, MaterialKind};
 use crate::sampling::{SamplerLanes, power_heuristic_of};
 use crate::simd::{F32x8, M32x8, Real, V3};
 use crate::texture::{TexCtx, Texture};
-use glam::{Vec2, Vec3};
+use glam::Vec2;
 
 /// Eight lanes.
 pub(super) const LANES: usize = 8;
@@ -88,7 +88,7 @@ struct Gathered {
     direction: V3<F32x8>,
     throughput: V3<F32x8>,
     u_select: [f32; LANES],
-    u_light: [[f32; 2]; LANES],
+    u_light: [F32x8; 2],
     u_direction: [F32x8; 2],
 }
 
@@ -124,28 +124,28 @@ impl PathTracer<'_> {
         debug_assert!((1..=LANES).contains(&group.len()));
         let (scene, isa) = (self.scene, self.isa);
         let gathered = self.gather(group, paths);
-        let (s, frame, wo) = isa.run(
+        let two_sided = scene.materials[material as usize].two_sided;
+        // One AVX2 function for the whole stage, the reflectance lookups included: the hit
+        // points and frames returned from one to the next were copied on the way.
+        let (s, shaded) = isa.run(
             #[inline(always)]
             || {
                 let s =
                     triangle_surface_of(gathered.triangle, gathered.normals, gathered.uvs, gathered.b1, gathered.b2);
-                (s, FrameOf::from_normal_tangent(s.shading_normal, s.dpdu), -gathered.direction.normalize())
-            },
-        );
-        let reflectance = match bsdf {
-            LaneBsdf::Diffuse { reflectance } => self.reflectances(reflectance, group, paths, material, &s, &frame, wo),
-            LaneBsdf::RoughConductor { .. } => V3::splat(0.0),
-        };
-        let two_sided = scene.materials[material as usize].two_sided;
-        let shaded = isa.run(
-            #[inline(always)]
-            || {
+                let mut frame = FrameOf::from_normal_tangent(s.shading_normal, s.dpdu);
+                let wo = -gathered.direction.normalize();
+                let reflectance = match bsdf {
+                    LaneBsdf::Diffuse { reflectance } => {
+                        self.reflectances(reflectance, group, paths, material, &s, &frame, wo)
+                    }
+                    LaneBsdf::RoughConductor { .. } => V3::splat(0.0),
+                };
                 // Two-sided materials see the back as the front: the normal mirrored to the viewer.
-                let mut frame = frame;
                 if two_sided {
                     frame.n = V3::select(frame.n.dot(wo).lt(F32x8::splat(0.0)), -frame.n, frame.n);
                 }
-                shade(bsdf, &scene.lights, &gathered, &s, &frame, wo, reflectance)
+                let shaded = shade(bsdf, &scene.lights, &gathered, &s, &frame, wo, reflectance);
+                (s.p, shaded)
             },
         );
         for (lane, &index) in group.iter().enumerate() {
@@ -162,7 +162,7 @@ impl PathTracer<'_> {
                 continue;
             }
             path.throughput *= Rgb::from(shaded.weight.lane(lane));
-            path.prev = PreviousVertex { p: s.p.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
+            path.prev = PreviousVertex { p: s.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
             path.ray = Ray::new(shaded.next_origin.lane(lane), shaded.next_direction.lane(lane));
             path.depth += 1;
             if self.survives_roulette(path) {
@@ -176,41 +176,39 @@ impl PathTracer<'_> {
     /// the paths draw what one-at-a-time shading draws). Lanes past the group's end repeat its
     /// last path, and its first path's numbers, without drawing.
     fn gather(&self, group: &[usize], paths: &mut [Path]) -> Gathered {
-        let mut triangle = [[Vec3::ZERO; LANES]; 3];
-        let mut normals = [[Vec3::ZERO; LANES]; 3];
-        let mut uvs = [[[0.0; LANES]; 2]; 3];
+        // Written lane by lane where they are kept: arrays transposed afterwards were copied.
+        let mut triangle = [V3::splat(0.0); 3];
+        let mut normals = [V3::splat(0.0); 3];
+        let mut uvs = [[F32x8([0.0; LANES]); 2]; 3];
         let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
-        let (mut direction, mut throughput) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+        let (mut direction, mut throughput) = (V3::splat(0.0), V3::splat(0.0));
         let mut draws = SamplerLanes { keys: [0; LANES], dimensions: [0; LANES] };
         let mut primitive = [0; LANES];
         for lane in 0..LANES {
             let path = &mut paths[group[lane.min(group.len() - 1)]];
             let hit = path.hit.expect("lanes shade hits");
             (primitive[lane], b1[lane], b2[lane]) = (hit.primitive, hit.b1, hit.b2);
-            (direction[lane], throughput[lane]) = (path.ray.d, path.throughput.into());
+            direction.set_lane(lane, path.ray.d);
+            throughput.set_lane(lane, path.throughput.into());
             // The light's choice, its point, the lobe, the direction: four draws.
             (draws.keys[lane], draws.dimensions[lane]) =
                 if lane < group.len() { path.sampler.reserve(4) } else { (draws.keys[0], draws.dimensions[0]) };
         }
         let (u_select, u_light, u_direction) = self.isa.run(
             #[inline(always)]
-            || {
-                let [light_x, light_y] = draws.draw_2d(1);
-                let u_light: [[f32; 2]; LANES] = std::array::from_fn(|lane| [light_x[lane], light_y[lane]]);
-                (draws.draw_1d(0), u_light, draws.draw_2d(3))
-            },
+            || (draws.draw_1d(0), draws.draw_2d(1).map(F32x8), draws.draw_2d(3)),
         );
         for (lane, &primitive) in primitive.iter().enumerate() {
             self.gather_triangle(primitive, lane, &mut triangle, &mut normals, &mut uvs);
         }
         Gathered {
-            triangle: triangle.map(V3::from),
-            normals: normals.map(V3::from),
-            uvs: uvs.map(|uv| uv.map(F32x8)),
+            triangle,
+            normals,
+            uvs,
             b1: F32x8(b1),
             b2: F32x8(b2),
-            direction: V3::from(direction),
-            throughput: V3::from(throughput),
+            direction,
+            throughput,
             u_select,
             u_light,
             u_direction: u_direction.map(F32x8),
@@ -223,16 +221,16 @@ impl PathTracer<'_> {
         &self,
         primitive: u32,
         lane: usize,
-        triangle: &mut [[Vec3; LANES]; 3],
-        normals: &mut [[Vec3; LANES]; 3],
-        uvs: &mut [[[f32; LANES]; 2]; 3],
+        triangle: &mut [V3<F32x8>; 3],
+        normals: &mut [V3<F32x8>; 3],
+        uvs: &mut [[F32x8; 2]; 3],
     ) {
         for corner in 0..3 {
             let (p, n, uv) = self.scene.geometry.triangle_corner(primitive as usize, corner);
-            triangle[corner][lane] = p;
-            normals[corner][lane] = n;
-            uvs[corner][0][lane] = uv.x;
-            uvs[corner][1][lane] = uv.y;
+            triangle[corner].set_lane(lane, p);
+            normals[corner].set_lane(lane, n);
+            uvs[corner][0].0[lane] = uv.x;
+            uvs[corner][1].0[lane] = uv.y;
         }
     }
 
@@ -260,7 +258,7 @@ impl PathTracer<'_> {
             #[inline(always)]
             || s.dpdu.cross(s.dpdv).dot(s.ng).lt(F32x8::splat(0.0)),
         );
-        let mut reflectances = [Vec3::ZERO; LANES];
+        let mut reflectances = V3::splat(0.0);
         for (lane, &index) in group.iter().enumerate() {
             let path = &paths[index];
             let uv = Vec2::new(s.uv[0].0[lane], s.uv[1].0[lane]);
@@ -286,9 +284,9 @@ impl PathTracer<'_> {
                 // A lookup at the point: no hit point to build.
                 TexCtx { uv, duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO, uv_mirrored: Some(mirrored) }
             };
-            reflectances[lane] = reflectance.eval(&self.scene.textures, &ctx).into();
+            reflectances.set_lane(lane, reflectance.eval(&self.scene.textures, &ctx).into());
         }
-        V3::from(reflectances)
+        reflectances
     }
 
     /// The diffuse reflectance `reflectance` at the points `s` where it is an image looked up at
@@ -300,14 +298,14 @@ impl PathTracer<'_> {
         let Texture::Image(image) = &self.scene.textures[id.0 as usize] else { return None };
         // The footprint every lookup without derivatives has.
         let footprint = image.prepare(Vec2::ZERO, Vec2::ZERO);
-        let mut reflectances = [Vec3::ZERO; LANES];
-        for (quad, out) in reflectances.chunks_exact_mut(4).enumerate() {
-            let uv = std::array::from_fn(|l| Vec2::new(s.uv[0].0[4 * quad + l], s.uv[1].0[4 * quad + l]));
-            for (out, value) in out.iter_mut().zip(image.eval_prepared_x4(uv, &footprint)?) {
-                *out = (Rgb::from_vec4(value) * scale).into();
+        let mut reflectances = V3::splat(0.0);
+        for quad in [0, 4] {
+            let uv = std::array::from_fn(|l| Vec2::new(s.uv[0].0[quad + l], s.uv[1].0[quad + l]));
+            for (l, value) in image.eval_prepared_x4(uv, &footprint)?.into_iter().enumerate() {
+                reflectances.set_lane(quad + l, (Rgb::from_vec4(value) * scale).into());
             }
         }
-        Some(V3::from(reflectances))
+        Some(reflectances)
     }
 }
 

@@ -121,60 +121,64 @@ impl Lights {
         Some(s)
     }
 
-    /// [`Lights::sample`] from eight points `p` in lanes, with the numbers `u_select` and `u`
-    /// of each lane. The light, and a mesh light's triangle, are chosen lane by lane; the point
+    /// [`Lights::sample`] from eight points `p` in lanes, with the numbers `u_select` and the
+    /// pairs `u` (first numbers, second numbers) of each lane. The light, and a mesh light's triangle, are chosen lane by lane; the point
     /// on the triangle and a constant environment's direction are computed in lanes, and the
     /// one each lane chose kept. Other lights (spheres, points, suns, environment maps) are
     /// sampled lane by lane ([`Lights::sample`]).
     #[inline(always)]
-    pub fn sample_lanes(&self, p: V3<F32x8>, u_select: [f32; 8], u: [[f32; 2]; 8]) -> LightSampleLanes {
-        let mut triangle = [[Vec3::ZERO; 8]; 3];
-        let mut normal = [Vec3::ZERO; 8];
+    pub fn sample_lanes(&self, p: V3<F32x8>, u_select: [f32; 8], u: [F32x8; 2]) -> LightSampleLanes {
+        let [u_x, u_y] = u;
+        // Lanes written in place (arrays transposed afterwards were copied).
+        let mut triangle = [V3::splat(0.0); 3];
+        let mut normal = V3::splat(0.0);
         let (mut u_triangle, mut area) = ([0.0; 8], [1.0; 8]);
-        let mut radiance = [Vec3::ZERO; 8];
+        let mut radiance = V3::splat(0.0);
         // Lanes that chose a light, that chose the constant sky, and those sampled one at a time
         // (with what that gave).
         let (mut chosen, mut sky, mut alone) = ([false; 8], [false; 8], [false; 8]);
-        let (mut alone_wi, mut alone_point, mut alone_pdf) = ([Vec3::ZERO; 8], [Vec3::ZERO; 8], [0.0; 8]);
+        let (mut alone_wi, mut alone_point, mut alone_pdf) = (V3::splat(0.0), V3::splat(0.0), [0.0; 8]);
         let (mut alone_valid, mut alone_at_infinity, mut delta) = ([false; 8], [false; 8], [false; 8]);
         // The environment's index, where there is one: after the areas, points and suns.
         let sky_index = self.area.len() + self.points.len() + self.distant.len();
         for lane in 0..8 {
             let Some(i) = self.choose(u_select[lane]) else { continue };
             chosen[lane] = true;
-            let mesh = self.area.get(i).and_then(|light| Some((light, light.pick_triangle(u[lane][0])?)));
+            let mesh = self.area.get(i).and_then(|light| Some((light, light.pick_triangle(u_x.0[lane])?)));
             if let Some((light, (vertices, n, u_remapped))) = mesh {
                 for (corner, v) in triangle.iter_mut().zip(vertices) {
-                    corner[lane] = v;
+                    corner.set_lane(lane, v);
                 }
-                (normal[lane], u_triangle[lane], area[lane]) = (n, u_remapped, light.area());
-                radiance[lane] = light.radiance.into();
+                normal.set_lane(lane, n);
+                (u_triangle[lane], area[lane]) = (u_remapped, light.area());
+                radiance.set_lane(lane, light.radiance.into());
             } else if let (true, Some(Environment::Constant(c))) = (i == sky_index, &self.environment) {
                 sky[lane] = true;
-                radiance[lane] = (*c).into();
+                radiance.set_lane(lane, (*c).into());
             } else {
                 alone[lane] = true;
-                let Some(s) = self.sample_chosen(i, p.lane(lane), Vec2::from(u[lane])) else { continue };
-                (alone_valid[lane], alone_wi[lane], alone_pdf[lane]) = (true, s.wi, s.pdf);
-                (alone_point[lane], alone_at_infinity[lane]) = (s.point.unwrap_or(Vec3::ZERO), s.point.is_none());
-                (radiance[lane], delta[lane]) = (s.radiance.into(), s.delta);
+                let Some(s) = self.sample_chosen(i, p.lane(lane), Vec2::new(u_x.0[lane], u_y.0[lane])) else {
+                    continue;
+                };
+                (alone_valid[lane], alone_pdf[lane]) = (true, s.pdf);
+                alone_wi.set_lane(lane, s.wi);
+                alone_point.set_lane(lane, s.point.unwrap_or(Vec3::ZERO));
+                alone_at_infinity[lane] = s.point.is_none();
+                radiance.set_lane(lane, s.radiance.into());
+                delta[lane] = s.delta;
             }
         }
-        let u_x = F32x8::from_fn(|lane| u[lane][0]);
-        let u_y = F32x8::from_fn(|lane| u[lane][1]);
-        let normal = V3::from(normal);
-        let (q, pdf) =
-            area::triangle_point_of(p, triangle.map(V3::from), normal, [F32x8(u_triangle), u_y], F32x8(area));
+        let (q, pdf) = area::triangle_point_of(p, triangle, normal, [F32x8(u_triangle), u_y], F32x8(area));
         let toward = area::toward_light_of(p, q, normal, pdf);
         let (sky, alone) = (M32x8::from_bools(sky), M32x8::from_bools(alone));
         let pdf = F32x8::select(sky, F32x8::splat(crate::sampling::warp::UNIFORM_SPHERE_PDF), pdf);
         let wi = V3::select(sky, crate::sampling::warp::square_to_uniform_sphere_of([u_x, u_y]), toward.wi);
         let in_lanes_valid = sky | toward.valid;
         LightSampleLanes {
-            wi: V3::select(alone, V3::from(alone_wi), wi),
-            radiance: V3::from(radiance),
+            wi: V3::select(alone, alone_wi, wi),
+            radiance,
             pdf: F32x8::select(alone, F32x8(alone_pdf), pdf * F32x8::splat(self.selection_pdf())),
-            point: V3::select(alone, V3::from(alone_point), toward.point),
+            point: V3::select(alone, alone_point, toward.point),
             at_infinity: sky | M32x8::from_bools(alone_at_infinity),
             delta: M32x8::from_bools(delta),
             valid: M32x8::from_bools(chosen) & ((alone & M32x8::from_bools(alone_valid)) | (!alone & in_lanes_valid)),
@@ -258,7 +262,8 @@ mod tests {
                 };
                 let u_select: [f32; 8] = std::array::from_fn(|i| numbers(chunk + 7, i)[0]);
                 let u: [[f32; 2]; 8] = std::array::from_fn(|i| numbers(chunk, i));
-                let lanes = isa.run(|| lights.sample_lanes(gather(p), u_select, u));
+                let u_lanes = [F32x8::from_fn(|i| u[i][0]), F32x8::from_fn(|i| u[i][1])];
+                let lanes = isa.run(|| lights.sample_lanes(gather(p), u_select, u_lanes));
                 for i in 0..8 {
                     let Some(one) = lights.sample(p(i), u_select[i], Vec2::from(u[i])) else {
                         assert!(!lanes.valid.test(i), "{isa:?} p {} u {:?}", p(i), u[i]);
@@ -290,7 +295,8 @@ mod tests {
         }
         assert!(seen.iter().all(|&n| n > 500), "points, sky and failed samples seen {seen:?} times");
         // Without lights, no lane has a sample.
-        let none = Isa::Portable.run(|| Lights::default().sample_lanes(gather(direction), [0.5; 8], [[0.5; 2]; 8]));
+        let none =
+            Isa::Portable.run(|| Lights::default().sample_lanes(gather(direction), [0.5; 8], [F32x8::splat(0.5); 2]));
         assert_eq!(none.valid, M32x8::from_bools([false; 8]));
     }
 }

@@ -289,6 +289,12 @@ impl V3<F32x8> {
     pub fn lane(&self, i: usize) -> glam::Vec3 {
         glam::Vec3::new(self.x.0[i], self.y.0[i], self.z.0[i])
     }
+
+    /// Set lane `i` to `v` (a gather written in place, outside the lane kernels).
+    #[inline(always)]
+    pub fn set_lane(&mut self, i: usize, v: glam::Vec3) {
+        (self.x.0[i], self.y.0[i], self.z.0[i]) = (v.x, v.y, v.z);
+    }
 }
 
 /// What the lane tests of the BSDFs share.
