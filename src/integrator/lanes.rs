@@ -6,10 +6,11 @@
 //! other lights lane by lane ([`crate::light::Lights::sample_lanes`]). Other vertices are
 //! shaded one at a time ([`PathTracer::shade`]).
 //!
-//! Lanes gather what they need path by path (the triangle, the ray, the sampler's numbers, the
-//! light's triangle, the texture's reflectance), compute the hit point, the shading frame, the
-//! light sample, both BSDF evaluations, the MIS weight, the shadow ray and the next ray eight at
-//! a time, and hand the results back path by path. Each path draws the numbers that a path
+//! Lanes gather what they need path by path (the triangle, the ray, the sampler's stream, the
+//! light's triangle, the texture's reflectance), writing each lane in place, compute the random
+//! numbers, the hit point, the shading frame, the light sample, both BSDF evaluations, the MIS
+//! weight, the shadow ray and the next ray eight at a time, and hand the results back path by
+//! path. Each path draws the numbers that a path
 //! shaded alone draws, in the same order (the light's choice, its point, the lobe, the
 //! direction, Russian roulette), and nothing a lane computes depends on the other lanes, so the
 //! image depends neither on how paths are grouped nor on the instruction set
@@ -127,7 +128,7 @@ impl PathTracer<'_> {
         let two_sided = scene.materials[material as usize].two_sided;
         // One AVX2 function for the whole stage, the reflectance lookups included: the hit
         // points and frames returned from one to the next were copied on the way.
-        let (s, shaded) = isa.run(
+        let (points, shaded) = isa.run(
             #[inline(always)]
             || {
                 let s =
@@ -162,7 +163,7 @@ impl PathTracer<'_> {
                 continue;
             }
             path.throughput *= Rgb::from(shaded.weight.lane(lane));
-            path.prev = PreviousVertex { p: s.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
+            path.prev = PreviousVertex { p: points.lane(lane), pdf: shaded.pdf.0[lane], delta: false };
             path.ray = Ray::new(shaded.next_origin.lane(lane), shaded.next_direction.lane(lane));
             path.depth += 1;
             if self.survives_roulette(path) {

@@ -84,9 +84,9 @@ impl Sampler {
 /// [`Sampler::next_2d`] give: the hashes are computed eight at a time, in 64-bit lanes.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SamplerLanes {
-    /// Per lane, the sampler's key and the dimension of its first reserved draw
-    /// ([`Sampler::reserve`]).
+    /// Per lane, the sampler's key ([`Sampler::reserve`]).
     pub(crate) keys: [u64; 8],
+    /// Per lane, the dimension of the sampler's first reserved draw.
     pub(crate) dimensions: [u32; 8],
 }
 
