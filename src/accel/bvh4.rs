@@ -53,13 +53,19 @@ impl Leaf {
     }
 }
 
+/// Four triangles of a leaf, for its tests, and the index of each lane's triangle (short packets
+/// repeat their first), kept together so that a hit reads its index beside the triangles.
+#[derive(Clone, Copy, Debug)]
+struct Packet {
+    triangles: TrianglePacket,
+    ids: [u32; 4],
+}
+
 /// The four-wide BVH; node 0 is the root.
 pub(super) struct Bvh4 {
     nodes: Vec<Node>,
     leaves: Vec<Leaf>,
-    packets: Vec<TrianglePacket>,
-    /// Per packet, the triangle of each lane.
-    packet_triangles: Vec<[u32; 4]>,
+    packets: Vec<Packet>,
 }
 
 /// Per-ray constants of the box test.
@@ -252,7 +258,7 @@ impl Bvh4 {
             bvh2,
             triangles,
             sizes: subtree_sizes(bvh2),
-            out: Bvh4 { nodes: Vec::new(), leaves: Vec::new(), packets: Vec::new(), packet_triangles: Vec::new() },
+            out: Bvh4 { nodes: Vec::new(), leaves: Vec::new(), packets: Vec::new() },
         };
         // Depth first, without recursion: binary nodes still to emit, and where they go.
         let mut pending = Vec::new();
@@ -268,7 +274,7 @@ impl Bvh4 {
     pub(super) fn memory_bytes(&self) -> usize {
         self.nodes.len() * size_of::<Node>()
             + self.leaves.len() * size_of::<Leaf>()
-            + self.packets.len() * (size_of::<TrianglePacket>() + size_of::<[u32; 4]>())
+            + self.packets.len() * size_of::<Packet>()
     }
 
     /// The closest hit with `0 < t < ray.t_max`.
@@ -277,8 +283,9 @@ impl Bvh4 {
         let mut closest: Option<Hit> = None;
         self.traverse::<true>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
             for p in leaf.packets() {
-                if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&self.packets[p], *t_max) {
-                    closest = Some(Hit { primitive: self.packet_triangles[p][lane], t, b1, b2 });
+                let packet = &self.packets[p];
+                if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
+                    closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
                     *t_max = t;
                 }
             }
@@ -292,7 +299,7 @@ impl Bvh4 {
         let shear = RayShear::new(ray);
         let mut blocked = false;
         self.traverse::<false>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
-            blocked = leaf.packets().any(|p| shear.occludes(&self.packets[p], *t_max));
+            blocked = leaf.packets().any(|p| shear.occludes(&self.packets[p].triangles, *t_max));
             blocked
         });
         blocked
@@ -345,8 +352,9 @@ impl Bvh4 {
                     continue;
                 }
                 for p in leaf.packets() {
-                    if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&self.packets[p], t_max[k]) {
-                        hits[index[k]] = Some(Hit { primitive: self.packet_triangles[p][lane], t, b1, b2 });
+                    let packet = &self.packets[p];
+                    if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&packet.triangles, t_max[k]) {
+                        hits[index[k]] = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
                         t_max[k] = t;
                     }
                 }
@@ -548,8 +556,8 @@ impl Builder<'_> {
         }
         for chunk in ids.chunks(4) {
             let tris: Vec<[Vec3; 3]> = chunk.iter().map(|&i| self.triangles[i as usize]).collect();
-            out.packets.push(TrianglePacket::new(&tris));
-            out.packet_triangles.push(std::array::from_fn(|lane| *chunk.get(lane).unwrap_or(&chunk[0])));
+            let ids = std::array::from_fn(|lane| *chunk.get(lane).unwrap_or(&chunk[0]));
+            out.packets.push(Packet { triangles: TrianglePacket::new(&tris), ids });
         }
         out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first, lo, hi });
         LEAF | (out.leaves.len() as u32 - 1)
@@ -573,7 +581,7 @@ mod tests {
                 let leaf = bvh.leaves[(child & !LEAF) as usize];
                 for p in leaf.first..leaf.first + leaf.count {
                     // Short packets repeat their first triangle.
-                    let mut lanes = bvh.packet_triangles[p as usize].to_vec();
+                    let mut lanes = bvh.packets[p as usize].ids.to_vec();
                     lanes.sort();
                     lanes.dedup();
                     for t in lanes {
