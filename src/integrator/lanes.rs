@@ -126,9 +126,10 @@ impl PathTracer<'_> {
         let (scene, isa) = (self.scene, self.isa);
         let gathered = self.gather(group, paths);
         let two_sided = scene.materials[material as usize].two_sided;
-        // One AVX2 function for the whole stage, the reflectance lookups included: the hit
-        // points and frames returned from one to the next were copied on the way.
-        let (points, shaded) = isa.run(
+        // One AVX2 function for the whole stage, the reflectance lookups and the paths' updates
+        // included: what one part returned to the next (hit points, frames, the shaded lanes)
+        // was copied on the way.
+        isa.run(
             #[inline(always)]
             || {
                 let s =
@@ -146,9 +147,24 @@ impl PathTracer<'_> {
                     frame.n = V3::select(frame.n.dot(wo).lt(F32x8::splat(0.0)), -frame.n, frame.n);
                 }
                 let shaded = shade(bsdf, &scene.lights, &gathered, &s, &frame, wo, reflectance);
-                (s.p, shaded)
+                self.scatter(&shaded, &s.p, group, paths, shadow, alive);
             },
         );
+    }
+
+    /// Hand the lanes' results `shaded` (at hit points `points`) back to the paths of `group`:
+    /// queue their shadow tests in `shadow`, continue their rays, and push the paths that go on
+    /// to `alive`.
+    #[inline(always)]
+    fn scatter(
+        &self,
+        shaded: &Shaded,
+        points: &V3<F32x8>,
+        group: &[usize],
+        paths: &mut [Path],
+        shadow: &mut Vec<ShadowTest>,
+        alive: &mut Vec<usize>,
+    ) {
         for (lane, &index) in group.iter().enumerate() {
             let path = &mut paths[index];
             if shaded.contributes.test(lane) {
