@@ -69,7 +69,7 @@ fn area_light_sampling_matches_pdf_chi2() {
         [Vec3::new(-1.5, -1.0, 0.2), Vec3::new(-1.0, -2.0, 0.2), Vec3::new(-0.5, -1.5, 0.3)],
     ];
     let light = AreaLight::new(quad.to_vec(), tessera::color::Rgb::ONE);
-    let accel = Accel::build(&quad, &[]);
+    let accel = Accel::build(&quad, &[true; 4], &[]);
     let p = Vec3::new(0.1, 0.2, -0.3);
     let pdf = |w: Vec3| {
         let Some(hit) = accel.intersect(&Ray::new(p, w)) else { return 0.0 };
@@ -100,7 +100,7 @@ fn sphere_light_sampling_matches_pdf_chi2() {
     for (seed, p, flip) in [(24, Vec3::new(0.1, 0.2, -0.3), false), (25, Vec3::new(0.5, 0.1, 1.2), true)] {
         let sphere = Sphere::new(to_world, flip).unwrap();
         let light = AreaLight::sphere(sphere.clone(), tessera::color::Rgb::ONE);
-        let accel = Accel::build(&[], std::slice::from_ref(&sphere));
+        let accel = Accel::build(&[], &[], std::slice::from_ref(&sphere));
         let pdf = |w: Vec3| {
             let ray = Ray::new(p, w);
             let Some(hit) = accel.intersect(&ray) else { return 0.0 };

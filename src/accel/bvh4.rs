@@ -15,6 +15,7 @@
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
 //! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches.
 
+use super::leaf_plane::LeafPlane;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
 use super::{Hit, TraversalStack};
 use crate::geometry::Ray;
@@ -37,15 +38,21 @@ struct Node {
     children: [u32; 4],
 }
 
-/// The triangles of one leaf: `count` packets from `first`, and their bounding box (for the
-/// per-ray test of [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray).
+/// The triangles of one leaf: `count` packets from `first`, their bounding box (for the
+/// per-ray test of [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray),
+/// and, where they all emit and are flat, their plane (an index into `Bvh4::planes`, else
+/// [`NO_PLANE`]), which shadow rays towards them clear ([`LeafPlane`]).
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     first: u32,
     count: u32,
+    plane: u32,
     lo: Vec3A,
     hi: Vec3A,
 }
+
+/// [`Leaf::plane`] of a leaf without one.
+const NO_PLANE: u32 = u32::MAX;
 
 impl Leaf {
     fn packets(&self) -> std::ops::Range<usize> {
@@ -66,6 +73,7 @@ pub(super) struct Bvh4 {
     nodes: Vec<Node>,
     leaves: Vec<Leaf>,
     packets: Vec<Packet>,
+    planes: Vec<LeafPlane>,
 }
 
 /// Per-ray constants of the box test.
@@ -252,13 +260,15 @@ fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
 }
 
 impl Bvh4 {
-    /// Collapse `bvh2`, built over `triangles`, into a four-wide BVH.
-    pub(super) fn from_bvh2(bvh2: &Bvh2, triangles: &[[Vec3; 3]]) -> Self {
+    /// Collapse `bvh2`, built over `triangles`, into a four-wide BVH; `emitting` tells which
+    /// triangles emit (none where it is empty), whose flat leaves keep their planes.
+    pub(super) fn from_bvh2(bvh2: &Bvh2, triangles: &[[Vec3; 3]], emitting: &[bool]) -> Self {
         let mut builder = Builder {
             bvh2,
             triangles,
+            emitting,
             sizes: subtree_sizes(bvh2),
-            out: Bvh4 { nodes: Vec::new(), leaves: Vec::new(), packets: Vec::new() },
+            out: Bvh4 { nodes: Vec::new(), leaves: Vec::new(), packets: Vec::new(), planes: Vec::new() },
         };
         // Depth first, without recursion: binary nodes still to emit, and where they go.
         let mut pending = Vec::new();
@@ -275,6 +285,7 @@ impl Bvh4 {
         self.nodes.len() * size_of::<Node>()
             + self.leaves.len() * size_of::<Leaf>()
             + self.packets.len() * size_of::<Packet>()
+            + self.planes.len() * size_of::<LeafPlane>()
     }
 
     /// The closest hit with `0 < t < ray.t_max`.
@@ -299,6 +310,9 @@ impl Bvh4 {
         let shear = RayShear::new(ray);
         let mut blocked = false;
         self.traverse::<false>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
+            if leaf.plane != NO_PLANE && self.planes[leaf.plane as usize].clears(ray, *t_max) {
+                return false;
+            }
             blocked = leaf.packets().any(|p| shear.occludes(&self.packets[p].triangles, *t_max));
             blocked
         });
@@ -485,6 +499,7 @@ fn subtree_sizes(bvh2: &Bvh2) -> Vec<u32> {
 struct Builder<'a> {
     bvh2: &'a Bvh2,
     triangles: &'a [[Vec3; 3]],
+    emitting: &'a [bool],
     sizes: Vec<u32>,
     out: Bvh4,
 }
@@ -559,7 +574,16 @@ impl Builder<'_> {
             let ids = std::array::from_fn(|lane| *chunk.get(lane).unwrap_or(&chunk[0]));
             out.packets.push(Packet { triangles: TrianglePacket::new(&tris), ids });
         }
-        out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first, lo, hi });
+        let emits = !self.emitting.is_empty() && ids.iter().all(|&i| self.emitting[i as usize]);
+        let plane =
+            match emits.then(|| LeafPlane::of(&ids.iter().map(|&i| self.triangles[i as usize]).collect::<Vec<_>>())) {
+                Some(Some(plane)) => {
+                    out.planes.push(plane);
+                    out.planes.len() as u32 - 1
+                }
+                _ => NO_PLANE,
+            };
+        out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first, plane, lo, hi });
         LEAF | (out.leaves.len() as u32 - 1)
     }
 }
@@ -571,7 +595,7 @@ mod tests {
     #[test]
     fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
         let tris = crate::accel::tests::lopsided_scene();
-        let bvh = crate::accel::build_bvh4(&tris);
+        let bvh = crate::accel::build_bvh4(&tris, &[]);
 
         // Walk the tree: every triangle is reached exactly once, inside every box above it.
         let mut seen = vec![0u32; tris.len()];

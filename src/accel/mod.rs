@@ -11,6 +11,7 @@
 mod bvh4;
 #[cfg(feature = "embree")]
 mod embree;
+mod leaf_plane;
 mod spheres;
 mod watertight;
 
@@ -72,27 +73,30 @@ pub struct Accel {
 }
 
 impl Accel {
-    /// Build the default kind over `triangles` and `spheres`. Triangles of zero area are
-    /// allowed: they are never hit.
-    pub fn build(triangles: &[[Vec3; 3]], spheres: &[Sphere]) -> Self {
-        Self::build_kind(triangles, spheres, AccelKind::DEFAULT)
+    /// Build the default kind over `triangles` (`emitting` as for [`Accel::build_kind`]) and
+    /// `spheres`. Triangles of zero area are allowed: they are never hit.
+    pub fn build(triangles: &[[Vec3; 3]], emitting: &[bool], spheres: &[Sphere]) -> Self {
+        Self::build_kind(triangles, emitting, spheres, AccelKind::DEFAULT)
     }
 
     /// Build `kind` over `triangles` (the spheres have their own BVH, the same for every kind).
-    /// Where Embree fails to build (an unsupported CPU), this says so and builds the four-wide
-    /// BVH instead.
-    pub fn build_kind(triangles: &[[Vec3; 3]], spheres: &[Sphere], kind: AccelKind) -> Self {
+    /// `emitting` tells which triangles emit (one per triangle, or empty where none do): the
+    /// four-wide BVH lets shadow rays that clear a flat emitting leaf's plane skip its triangles
+    /// (`leaf_plane.rs`), with the same answers. Where Embree fails to build (an unsupported
+    /// CPU), this says so and builds the four-wide BVH instead.
+    pub fn build_kind(triangles: &[[Vec3; 3]], emitting: &[bool], spheres: &[Sphere], kind: AccelKind) -> Self {
+        assert!(emitting.is_empty() || emitting.len() == triangles.len(), "one emitting flag per triangle");
         let backend = if triangles.is_empty() {
             Backend::Empty
         } else {
             match kind {
-                AccelKind::Bvh4 => Backend::Bvh4(build_bvh4(triangles)),
+                AccelKind::Bvh4 => Backend::Bvh4(build_bvh4(triangles, emitting)),
                 #[cfg(feature = "embree")]
                 AccelKind::Embree => match embree::EmbreeScene::build(triangles) {
                     Ok(scene) => Backend::Embree(scene),
                     Err(e) => {
                         eprintln!("warning: {e}; using tessera's own BVH");
-                        Backend::Bvh4(build_bvh4(triangles))
+                        Backend::Bvh4(build_bvh4(triangles, emitting))
                     }
                 },
             }
@@ -266,13 +270,14 @@ thread_local! {
     static TRAVERSAL_STACK: std::cell::RefCell<TraversalStack> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// obvhs's binary BVH (leaves of up to four triangles: one packet), collapsed four-wide.
-fn build_bvh4(triangles: &[[Vec3; 3]]) -> Bvh4 {
+/// obvhs's binary BVH (leaves of up to four triangles: one packet), collapsed four-wide; the
+/// flat leaves of `emitting` triangles keep their planes.
+fn build_bvh4(triangles: &[[Vec3; 3]], emitting: &[bool]) -> Bvh4 {
     let prims: Vec<Triangle> =
         triangles.iter().map(|t| Triangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
     let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::medium_build() };
     let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(&prims, params, &mut std::time::Duration::default());
-    Bvh4::from_bvh2(&bvh2, triangles)
+    Bvh4::from_bvh2(&bvh2, triangles, emitting)
 }
 
 #[cfg(test)]
@@ -326,7 +331,7 @@ mod tests {
 
     /// Every backend this build has, built over `tris`.
     fn each_kind(tris: &[[Vec3; 3]]) -> impl Iterator<Item = (AccelKind, Accel)> {
-        AccelKind::ALL.iter().map(|&kind| (kind, Accel::build_kind(tris, &[], kind)))
+        AccelKind::ALL.iter().map(|&kind| (kind, Accel::build_kind(tris, &[], &[], kind)))
     }
 
     #[test]
@@ -386,7 +391,7 @@ mod tests {
         // and answer alike.
         let mut rng = Lcg(23);
         let tris = random_scene(&mut rng, 500);
-        let accel = Accel::build(&tris, &[]);
+        let accel = Accel::build(&tris, &[], &[]);
         let rays: Vec<Ray> = (0..200).map(|_| Ray::new(rng.vec(4.0), rng.vec(1.0))).collect();
         accel.queries(|outer| {
             for ray in &rays {
@@ -396,6 +401,57 @@ mod tests {
                 assert_eq!(inner.is_some(), accel.occluded(ray), "ray {ray:?}");
             }
         });
+    }
+
+    #[test]
+    fn emitting_leaves_answer_shadow_rays_as_other_leaves_do() {
+        // Random triangles around quad lights of several sizes and tilts (each its own flat
+        // leaf, or sharing one), some near the triangles: shadow rays towards points on the
+        // lights, as the integrator spawns them, and segments that cross a light, graze it or
+        // end on it, answer alike with the emitting flags and without, and as brute force does.
+        let mut rng = Lcg(31);
+        let mut tris = random_scene(&mut rng, 600);
+        let mut quads = Vec::new();
+        for (size, centre) in [(1.0, Vec3::new(2.0, 6.0, 1.0)), (0.05, Vec3::new(-3.0, 1.0, 2.0)), (20.0, Vec3::ZERO)] {
+            let rotation = glam::Quat::from_euler(glam::EulerRot::XYZ, rng.next() * 6.0, rng.next() * 6.0, 0.0);
+            let corner = move |x: f32, y: f32| centre + rotation * Vec3::new(x - 0.5, y - 0.5, 0.0) * size;
+            let first = tris.len();
+            tris.push([corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0)]);
+            tris.push([corner(0.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)]);
+            quads.push((first, rotation * Vec3::Z, corner));
+        }
+        let mut emitting = vec![false; tris.len()];
+        for &(first, ..) in &quads {
+            emitting[first..first + 2].fill(true);
+        }
+        let plain = Accel::build_kind(&tris, &[], &[], AccelKind::Bvh4);
+        let with_emitters = Accel::build_kind(&tris, &emitting, &[], AccelKind::Bvh4);
+        let mut blocked = [0; 2];
+        for i in 0..20_000 {
+            let (_, normal, corner) = quads[i % quads.len()];
+            let q = corner(rng.next(), rng.next());
+            let o = match i % 4 {
+                0 => rng.vec(14.0),
+                // Near the light's plane: grazing rays.
+                1 => q + rng.vec(4.0) + normal * (rng.next() - 0.5) * 0.01,
+                _ => q + rng.vec(2.0),
+            };
+            let ray = match i % 6 {
+                // Through the light and beyond, or just reaching it.
+                0 => Ray { o, d: q - o, t_max: 1.0 + (rng.next() - 0.5) * 1e-3 },
+                4 => Ray { o, d: q - o, t_max: 1.5 },
+                1 => Ray::new(o, q - o),
+                _ => {
+                    let end = crate::geometry::offset_ray_origin(q, normal, o - q);
+                    Ray { o, d: end - o, t_max: crate::geometry::SHADOW_RAY_T_MAX }
+                }
+            };
+            let expected = brute_force(&tris, &ray).is_some();
+            assert_eq!(plain.occluded(&ray), expected, "ray {ray:?}");
+            assert_eq!(with_emitters.occluded(&ray), expected, "ray {ray:?}");
+            blocked[expected as usize] += 1;
+        }
+        assert!(blocked.iter().all(|&n| n > 2000), "both answers should be common: {blocked:?}");
     }
 
     #[test]
@@ -458,7 +514,7 @@ mod tests {
             })
             .collect();
         for kind in AccelKind::ALL {
-            let accel = Accel::build_kind(&tris, &spheres, *kind);
+            let accel = Accel::build_kind(&tris, &[], &spheres, *kind);
             assert_eq!(accel.sphere_count(), 60);
             let mut sphere_hits = 0;
             for _ in 0..4000 {
@@ -491,7 +547,7 @@ mod tests {
 
     #[test]
     fn accel_empty_scene_hits_nothing() {
-        let accel = Accel::build(&[], &[]);
+        let accel = Accel::build(&[], &[], &[]);
         let ray = Ray::new(Vec3::ZERO, Vec3::X);
         assert!(accel.intersect(&ray).is_none());
         assert!(!accel.occluded(&ray));

@@ -150,7 +150,7 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         .iter()
         .map(|&kind| {
             let start = Instant::now();
-            let accel = Accel::build_kind(&tris, &[], kind);
+            let accel = Accel::build_kind(&tris, &[], &[], kind);
             (kind, accel, start.elapsed().as_secs_f64())
         })
         .collect();
@@ -231,7 +231,8 @@ fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Re
     let s = scene.settings;
     let triangles = scene.geometry.all_triangle_positions();
     for &kind in AccelKind::ALL {
-        scene.accel = Accel::build_kind(&triangles, &scene.geometry.spheres, kind);
+        scene.accel =
+            Accel::build_kind(&triangles, &scene.geometry.emitting_triangles(), &scene.geometry.spheres, kind);
         let mut rates = Vec::new();
         for _ in 0..runs {
             let start = Instant::now();

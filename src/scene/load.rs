@@ -288,7 +288,7 @@ impl<'a> Loader<'a> {
             ));
         }
         let camera = self.camera(&desc.camera, &settings)?;
-        let accel = Accel::build(&geometry.all_triangle_positions(), &geometry.spheres);
+        let accel = Accel::build(&geometry.all_triangle_positions(), &geometry.emitting_triangles(), &geometry.spheres);
         Ok(Scene {
             path: self.path.to_path_buf(),
             settings,

@@ -153,6 +153,12 @@ impl Geometry {
         (0..self.triangles.len()).map(|t| self.triangle_positions(t)).collect()
     }
 
+    /// Whether each triangle emits (belongs to a shape with an area light), in order: what the
+    /// accelerator needs to know of them ([`crate::accel::Accel::build`]).
+    pub fn emitting_triangles(&self) -> Vec<bool> {
+        self.triangle_shape.iter().map(|&shape| self.shapes[shape as usize].light.is_some()).collect()
+    }
+
     /// Corner `corner` (0, 1 or 2) of triangle `i`: its position, its shading normal (zero where
     /// the mesh has none) and its texture coordinates ([`DEFAULT_UVS`] where the mesh has none):
     /// what [`Geometry::triangle_vertices`] gives at that corner, read without building the
