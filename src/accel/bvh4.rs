@@ -12,6 +12,9 @@
 //! whose box test bounds all its rays by interval arithmetic, with each ray's own box and
 //! triangle tests at the leaves (`intersect_many`).
 //!
+//! Leaves whose triangles all emit and lie in one plane (a quad light) keep that plane, and shadow
+//! rays that stay clear of it skip their triangle tests (`leaf_plane.rs`).
+//!
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
 //! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches.
 
