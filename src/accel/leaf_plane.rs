@@ -78,13 +78,8 @@ mod tests {
         ];
         let plane = LeafPlane::of(&quad).expect("a quad is flat");
         let normal = rotation * Vec3::Z;
-        let mut state = 0x2545f491u32;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / u32::MAX as f32
-        };
+        let mut rng = crate::accel::tests::Lcg(0x2545f491);
+        let mut next = || rng.next();
         for i in 0..2000 {
             let q = corner(next(), next());
             let side = if i % 2 == 0 { 1.0 } else { -1.0 };
