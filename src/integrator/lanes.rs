@@ -80,6 +80,7 @@ impl LaneBsdf {
 }
 
 /// What the lanes gather from the paths of a group.
+#[derive(Default)]
 struct Gathered {
     triangle: [V3<F32x8>; 3],
     normals: [V3<F32x8>; 3],
@@ -124,7 +125,8 @@ impl PathTracer<'_> {
     ) {
         debug_assert!((1..=LANES).contains(&group.len()));
         let (scene, isa) = (self.scene, self.isa);
-        let gathered = self.gather(group, paths);
+        let gathered = &mut Gathered::default();
+        self.gather(group, paths, gathered);
         let two_sided = scene.materials[material as usize].two_sided;
         // One AVX2 function for the whole stage, the reflectance lookups and the paths' updates
         // included: what one part returned to the next (hit points, frames, the shaded lanes)
@@ -146,7 +148,7 @@ impl PathTracer<'_> {
                 if two_sided {
                     frame.n = V3::select(frame.n.dot(wo).lt(F32x8::splat(0.0)), -frame.n, frame.n);
                 }
-                let shaded = shade(bsdf, &scene.lights, &gathered, &s, &frame, wo, reflectance);
+                let shaded = shade(bsdf, &scene.lights, gathered, &s, &frame, wo, reflectance);
                 self.scatter(&shaded, &s.p, group, paths, shadow, alive);
             },
         );
@@ -191,44 +193,30 @@ impl PathTracer<'_> {
     /// The group's triangles, rays and throughputs, and the numbers each path draws for its
     /// light sample and its BSDF sample (the lobe's number too, unused by these BSDFs, so that
     /// the paths draw what one-at-a-time shading draws). Lanes past the group's end repeat its
-    /// last path, and its first path's numbers, without drawing.
-    fn gather(&self, group: &[usize], paths: &mut [Path]) -> Gathered {
-        // Written lane by lane where they are kept: arrays transposed afterwards were copied.
-        let mut triangle = [V3::splat(0.0); 3];
-        let mut normals = [V3::splat(0.0); 3];
-        let mut uvs = [[F32x8([0.0; LANES]); 2]; 3];
-        let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
-        let (mut direction, mut throughput) = (V3::splat(0.0), V3::splat(0.0));
+    /// last path, and its first path's numbers, without drawing. Written into `gathered`, lane
+    /// by lane where they are kept: arrays transposed afterwards, or locals moved into the
+    /// struct at the end, were copied.
+    fn gather(&self, group: &[usize], paths: &mut [Path], gathered: &mut Gathered) {
+        let Gathered { triangle, normals, uvs, b1, b2, direction, throughput, u_select, u_light, u_direction } =
+            gathered;
         let mut draws = SamplerLanes { keys: [0; LANES], dimensions: [0; LANES] };
         let mut primitive = [0; LANES];
         for lane in 0..LANES {
             let path = &mut paths[group[lane.min(group.len() - 1)]];
             let hit = path.hit.expect("lanes shade hits");
-            (primitive[lane], b1[lane], b2[lane]) = (hit.primitive, hit.b1, hit.b2);
+            (primitive[lane], b1.0[lane], b2.0[lane]) = (hit.primitive, hit.b1, hit.b2);
             direction.set_lane(lane, path.ray.d);
             throughput.set_lane(lane, path.throughput.into());
             // The light's choice, its point, the lobe, the direction: four draws.
             (draws.keys[lane], draws.dimensions[lane]) =
                 if lane < group.len() { path.sampler.reserve(4) } else { (draws.keys[0], draws.dimensions[0]) };
         }
-        let (u_select, u_light, u_direction) = self.isa.run(
+        (*u_select, *u_light, *u_direction) = self.isa.run(
             #[inline(always)]
-            || (draws.draw_1d(0), draws.draw_2d(1).map(F32x8), draws.draw_2d(3)),
+            || (draws.draw_1d(0), draws.draw_2d(1).map(F32x8), draws.draw_2d(3).map(F32x8)),
         );
         for (lane, &primitive) in primitive.iter().enumerate() {
-            self.gather_triangle(primitive, lane, &mut triangle, &mut normals, &mut uvs);
-        }
-        Gathered {
-            triangle,
-            normals,
-            uvs,
-            b1: F32x8(b1),
-            b2: F32x8(b2),
-            direction,
-            throughput,
-            u_select,
-            u_light,
-            u_direction: u_direction.map(F32x8),
+            self.gather_triangle(primitive, lane, triangle, normals, uvs);
         }
     }
 

@@ -159,7 +159,7 @@ impl Mask for glam::BVec3A {}
 
 /// A 3-vector of [`Real`]s, with glam's `Vec3` operations in glam's order of operations, so
 /// that `V3<f32>` computes what `Vec3` computes bit for bit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct V3<T> {
     /// x.
     pub x: T,
