@@ -577,15 +577,16 @@ impl Builder<'_> {
             let ids = std::array::from_fn(|lane| *chunk.get(lane).unwrap_or(&chunk[0]));
             out.packets.push(Packet { triangles: TrianglePacket::new(&tris), ids });
         }
+        // Only leaves whose triangles all emit keep their plane (`leaf_plane.rs` says why).
         let emits = !self.emitting.is_empty() && ids.iter().all(|&i| self.emitting[i as usize]);
-        let plane =
-            match emits.then(|| LeafPlane::of(&ids.iter().map(|&i| self.triangles[i as usize]).collect::<Vec<_>>())) {
-                Some(Some(plane)) => {
-                    out.planes.push(plane);
-                    out.planes.len() as u32 - 1
-                }
-                _ => NO_PLANE,
-            };
+        let triangles = || ids.iter().map(|&i| self.triangles[i as usize]).collect::<Vec<_>>();
+        let plane = match emits.then(|| LeafPlane::of(&triangles())).flatten() {
+            Some(plane) => {
+                out.planes.push(plane);
+                out.planes.len() as u32 - 1
+            }
+            None => NO_PLANE,
+        };
         out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first, plane, lo, hi });
         LEAF | (out.leaves.len() as u32 - 1)
     }

@@ -439,8 +439,8 @@ mod tests {
             let ray = match i % 6 {
                 // Through the light and beyond, or just reaching it.
                 0 => Ray { o, d: q - o, t_max: 1.0 + (rng.next() - 0.5) * 1e-3 },
-                4 => Ray { o, d: q - o, t_max: 1.5 },
                 1 => Ray::new(o, q - o),
+                4 => Ray { o, d: q - o, t_max: 1.5 },
                 _ => {
                     let end = crate::geometry::offset_ray_origin(q, normal, o - q);
                     Ray { o, d: end - o, t_max: crate::geometry::SHADOW_RAY_T_MAX }

@@ -10,12 +10,12 @@
 //! light's triangle, the texture's reflectance), writing each lane in place, compute the random
 //! numbers, the hit point, the shading frame, the light sample, both BSDF evaluations, the MIS
 //! weight, the shadow ray and the next ray eight at a time, and hand the results back path by
-//! path. Each path draws the numbers that a path
-//! shaded alone draws, in the same order (the light's choice, its point, the lobe, the
-//! direction, Russian roulette), and nothing a lane computes depends on the other lanes, so the
-//! image depends neither on how paths are grouped nor on the instruction set
-//! ([`crate::simd::Isa`]). It differs from one-at-a-time shading only by the lanes' sine and
-//! cosine ([`crate::simd::trig`]), within the last bits of a sampled direction.
+//! path. Each path draws the numbers that a path shaded alone draws, in the same order (the
+//! light's choice, its point, the lobe, the direction, Russian roulette), and nothing a lane
+//! computes depends on the other lanes, so the image depends neither on how paths are grouped
+//! nor on the instruction set ([`crate::simd::Isa`]). It differs from one-at-a-time shading only
+//! by the lanes' sine and cosine ([`crate::simd::trig`]), within the last bits of a sampled
+//! direction.
 
 use super::path::{Path, PathTracer, PreviousVertex, ShadowTest, lookup_at};
 use crate::bsdf::fresnel::fresnel_conductor_of;

@@ -124,8 +124,9 @@ impl Lights {
     /// [`Lights::sample`] from eight points `p` in lanes, with the numbers `u_select` and the
     /// pairs `u` (their first numbers, then their second) of each lane. The light, and a mesh
     /// light's triangle, are chosen lane by lane; the point on the triangle and a constant
-    /// environment's direction are computed in lanes, and the one each lane chose kept. Other lights (spheres, points, suns, environment maps) are
-    /// sampled lane by lane ([`Lights::sample`]).
+    /// environment's direction are computed in lanes, and the one each lane chose kept. Other
+    /// lights (spheres, points, suns, environment maps) are sampled lane by lane
+    /// ([`Lights::sample`]).
     #[inline(always)]
     pub fn sample_lanes(&self, p: V3<F32x8>, u_select: [f32; 8], u: [F32x8; 2]) -> LightSampleLanes {
         let [u_x, u_y] = u;
