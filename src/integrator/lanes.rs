@@ -303,11 +303,16 @@ impl PathTracer<'_> {
         let Texture::Image(image) = &self.scene.textures[id.0 as usize] else { return None };
         // The footprint every lookup without derivatives has.
         let footprint = image.prepare(Vec2::ZERO, Vec2::ZERO);
-        let mut reflectances = V3::splat(0.0);
+        let mut reflectances: V3<F32x8> = V3::splat(0.0);
         for quad in [0, 4] {
             let uv = std::array::from_fn(|l| Vec2::new(s.uv[0].0[quad + l], s.uv[1].0[quad + l]));
-            for (l, value) in image.eval_prepared_x4(uv, &footprint)?.into_iter().enumerate() {
-                reflectances.set_lane(quad + l, (Rgb::from_vec4(value) * scale).into());
+            let [r, g, b] = image.eval_rgb_x4(uv, &footprint)?;
+            // Each lane's colour times the scale, channel by channel, as `ColorParam::eval`.
+            for (lanes, (value, scale)) in [&mut reflectances.x, &mut reflectances.y, &mut reflectances.z]
+                .into_iter()
+                .zip([(r, scale.x), (g, scale.y), (b, scale.z)])
+            {
+                lanes.0[quad..quad + 4].copy_from_slice(&(value * scale).to_array());
             }
         }
         Some(reflectances)

@@ -229,32 +229,37 @@ struct BilinearTapsX4 {
 }
 
 impl BilinearTapsX4 {
+    /// Lane `l`'s taps. The lanes are read as arrays: glam's indexing of a vector by a
+    /// run-time lane is a jump table, an indirect branch per lookup.
     #[inline(always)]
     fn lane(&self, l: usize) -> BilinearTaps {
         BilinearTaps {
             level: self.level as u32,
-            x: self.x.map(|x| x[l] as u32),
-            y: self.y.map(|y| y[l] as u32),
-            fx: self.fx[l],
-            fy: self.fy[l],
+            x: self.x.map(|x| x.to_array()[l] as u32),
+            y: self.y.map(|y| y.to_array()[l] as u32),
+            fx: self.fx.to_array()[l],
+            fy: self.fy.to_array()[l],
         }
     }
 
-    /// The bilinear blend, in lanes, of the two channels of `level` (which has two) at each
-    /// lane's four texels.
+    /// The bilinear blend, in lanes, of channels `picks` of `level` (`C` channels a texel) at
+    /// each lane's four texels, a vector per pick.
     #[inline(always)]
-    fn read_two_channels(&self, level: &Bitmap) -> [Vec4; 2] {
+    fn read_channels<const C: usize, const N: usize>(&self, level: &Bitmap, picks: [usize; N]) -> [Vec4; N] {
         let width = IVec4::splat(level.width as i32);
         let (row0, row1) = (self.y[0] * width, self.y[1] * width);
-        // A texel as one `[f32; 2]`: one bounds check and one load each.
-        let (texels, _) = level.data.as_chunks::<2>();
-        let t00 = two_channels_x4(texels, row0 + self.x[0]);
-        let t10 = two_channels_x4(texels, row0 + self.x[1]);
-        let t01 = two_channels_x4(texels, row1 + self.x[0]);
-        let t11 = two_channels_x4(texels, row1 + self.x[1]);
+        // A texel as one `[f32; C]`: one bounds check and one load each.
+        let (texels, _) = level.data.as_chunks::<C>();
+        let t00 = channels_x4(texels, row0 + self.x[0], picks);
+        let t10 = channels_x4(texels, row0 + self.x[1], picks);
+        let t01 = channels_x4(texels, row1 + self.x[0], picks);
+        let t11 = channels_x4(texels, row1 + self.x[1], picks);
         let (fx, gx, fy, gy) = (self.fx, Vec4::ONE - self.fx, self.fy, Vec4::ONE - self.fy);
-        let channel = |c: usize| (t00[c] * gx + t10[c] * fx) * gy + (t01[c] * gx + t11[c] * fx) * fy;
-        [channel(0), channel(1)]
+        let mut blended = [Vec4::ZERO; N];
+        for (c, b) in blended.iter_mut().enumerate() {
+            *b = (t00[c] * gx + t10[c] * fx) * gy + (t01[c] * gx + t11[c] * fx) * fy;
+        }
+        blended
     }
 }
 
@@ -275,10 +280,10 @@ fn wrapped_texels_x4(st: Vec4, n: f32) -> ([IVec4; 2], Vec4) {
     ([int_x4(first), int_x4(second)], x - floor)
 }
 
-/// The two channels of the texels at `offsets` (row-major indices, a texel per lane) of a
-/// two-channel level's `texels`, as a vector per channel.
+/// Channels `picks` of the texels at `offsets` (row-major indices, a texel per lane) of a
+/// level's `texels`, as a vector per pick.
 #[inline(always)]
-fn two_channels_x4(texels: &[[f32; 2]], offsets: IVec4) -> [Vec4; 2] {
+fn channels_x4<const C: usize, const N: usize>(texels: &[[f32; C]], offsets: IVec4, picks: [usize; N]) -> [Vec4; N] {
     // Lane by lane: `array::map` is a call that LLVM leaves out of line here.
     let (a, b, c, d) = (
         texels[offsets.x as usize],
@@ -286,7 +291,7 @@ fn two_channels_x4(texels: &[[f32; 2]], offsets: IVec4) -> [Vec4; 2] {
         texels[offsets.z as usize],
         texels[offsets.w as usize],
     );
-    [Vec4::new(a[0], b[0], c[0], d[0]), Vec4::new(a[1], b[1], c[1], d[1])]
+    picks.map(|k| Vec4::new(a[k], b[k], c[k], d[k]))
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -487,12 +492,39 @@ impl MipMap {
         #[cfg(debug_assertions)]
         assert_eq!(taps.base, (self.levels[0].width, self.levels[0].height), "taps of another layout");
         assert_eq!(self.levels[0].channels, 2, "a two-channel gather of a {}-channel pyramid", self.levels[0].channels);
-        let lower = taps.lower.read_two_channels(&self.levels[taps.lower.level]);
+        self.gather_channels_x4::<2, 2>(taps, [0, 1])
+    }
+
+    /// The red, green and blue of this pyramid filtered at each lane of `taps`, a vector per
+    /// channel: bit for bit the x, y and z of [`MipMap::gather`] of each [`TapsX4::lane`]. None
+    /// for more than four channels.
+    #[inline(always)]
+    pub fn gather_rgb_x4(&self, taps: &TapsX4) -> Option<[Vec4; 3]> {
+        #[cfg(debug_assertions)]
+        assert_eq!(taps.base, (self.levels[0].width, self.levels[0].height), "taps of another layout");
+        // Grey (and grey with alpha) is its grey in red, green and blue, as `Bitmap::pixel_of`.
+        Some(match self.levels[0].channels {
+            1 => self.gather_channels_x4::<1, 3>(taps, [0; 3]),
+            2 => self.gather_channels_x4::<2, 3>(taps, [0; 3]),
+            3 => self.gather_channels_x4::<3, 3>(taps, [0, 1, 2]),
+            4 => self.gather_channels_x4::<4, 3>(taps, [0, 1, 2]),
+            _ => return None,
+        })
+    }
+
+    /// Channels `picks` of this pyramid (`C` channels a texel) filtered at each lane of `taps`.
+    #[inline(always)]
+    fn gather_channels_x4<const C: usize, const N: usize>(&self, taps: &TapsX4, picks: [usize; N]) -> [Vec4; N] {
+        let lower = taps.lower.read_channels::<C, N>(&self.levels[taps.lower.level], picks);
         match taps.upper {
             None => lower,
             Some((upper, t)) => {
-                let upper = upper.read_two_channels(&self.levels[upper.level]);
-                [lower[0] * (1.0 - t) + upper[0] * t, lower[1] * (1.0 - t) + upper[1] * t]
+                let upper = upper.read_channels::<C, N>(&self.levels[upper.level], picks);
+                let mut blended = lower;
+                for (b, u) in blended.iter_mut().zip(upper) {
+                    *b = *b * (1.0 - t) + u * t;
+                }
+                blended
             }
         }
     }

@@ -117,20 +117,19 @@ impl ImageTexture {
     }
 
     /// [`ImageTexture::taps`] at four points with one footprint, in lanes ([`MipMap::taps_x4`]).
-    #[inline]
+    #[inline(always)]
     pub fn taps_x4(&self, uv: [Vec2; 4], footprint: &PreparedFootprint) -> Option<TapsX4> {
         let st = uv.map(|uv| image_coordinates(uv * self.scale + self.offset));
         let lanes = |f: fn(Vec2) -> f32| Vec4::new(f(st[0]), f(st[1]), f(st[2]), f(st[3]));
         self.mipmap.taps_x4(footprint, lanes(|st| st.x), lanes(|st| st.y))
     }
 
-    /// [`ImageTexture::eval_prepared`] at four points with one footprint, bit for bit, their
-    /// addresses and weights found in lanes ([`ImageTexture::taps_x4`]); None where lanes do not
-    /// serve the pyramid or the footprint.
+    /// The red, green and blue of [`ImageTexture::eval_prepared`] at four points with one
+    /// footprint, bit for bit, a vector per channel, found in lanes ([`ImageTexture::taps_x4`],
+    /// [`MipMap::gather_rgb_x4`]); None where lanes do not serve the pyramid or the footprint.
     #[inline]
-    pub fn eval_prepared_x4(&self, uv: [Vec2; 4], footprint: &PreparedFootprint) -> Option<[Vec4; 4]> {
-        let taps = self.taps_x4(uv, footprint)?;
-        Some(std::array::from_fn(|lane| self.mipmap.gather(&taps.lane(lane))))
+    pub fn eval_rgb_x4(&self, uv: [Vec2; 4], footprint: &PreparedFootprint) -> Option<[Vec4; 3]> {
+        self.mipmap.gather_rgb_x4(&self.taps_x4(uv, footprint)?)
     }
 
     /// The continuous MIP level that [`ImageTexture::eval`] reads at the lookup.
@@ -241,30 +240,41 @@ mod tests {
 
     #[test]
     fn image_lookups_in_lanes_are_the_lookups_bit_for_bit() {
-        let mut bitmap = Bitmap::new(23, 14, 3);
-        for (i, v) in bitmap.data.iter_mut().enumerate() {
-            *v = ((i * 2_654_435_761) % 1000) as f32 / 1000.0;
-        }
-        let mipmap = Arc::new(MipMap::new(bitmap));
-        for filter in [Filter::None, Filter::Trilinear] {
-            let image =
-                ImageTexture { mipmap: mipmap.clone(), filter, scale: Vec2::new(3.0, -1.5), offset: Vec2::splat(0.25) };
-            // The footprint of a lookup at the point, which a texture without a filter reads.
-            let footprint = image.prepare(Vec2::ZERO, Vec2::ZERO);
-            for i in 0..300 {
-                let uv: [Vec2; 4] = std::array::from_fn(|l| {
-                    let j = (4 * i + l) as f32;
-                    match (i + l) % 40 {
-                        0 => Vec2::new(f32::NAN, 0.5),
-                        1 => Vec2::new(-2e6 - j, 3e5),
-                        _ => Vec2::new(j * 0.0191 - 3.0, (j * 0.37).sin()),
+        // Grey, grey and alpha, RGB and RGBA; at the point and between two levels.
+        for channels in 1..=4 {
+            let mut bitmap = Bitmap::new(23, 14, channels);
+            for (i, v) in bitmap.data.iter_mut().enumerate() {
+                *v = ((i * 2_654_435_761) % 1000) as f32 / 1000.0;
+            }
+            let mipmap = Arc::new(MipMap::new(bitmap));
+            for (filter, duv_dx, duv_dy) in [
+                (Filter::None, Vec2::ZERO, Vec2::ZERO),
+                (Filter::Trilinear, Vec2::ZERO, Vec2::ZERO),
+                (Filter::Trilinear, Vec2::new(0.03, 0.01), Vec2::new(-0.01, 0.02)),
+            ] {
+                let image = ImageTexture {
+                    mipmap: mipmap.clone(),
+                    filter,
+                    scale: Vec2::new(3.0, -1.5),
+                    offset: Vec2::splat(0.25),
+                };
+                let footprint = image.prepare(duv_dx, duv_dy);
+                for i in 0..300 {
+                    let uv: [Vec2; 4] = std::array::from_fn(|l| {
+                        let j = (4 * i + l) as f32;
+                        match (i + l) % 40 {
+                            0 => Vec2::new(f32::NAN, 0.5),
+                            1 => Vec2::new(-2e6 - j, 3e5),
+                            _ => Vec2::new(j * 0.0191 - 3.0, (j * 0.37).sin()),
+                        }
+                    });
+                    let [r, g, b] = image.eval_rgb_x4(uv, &footprint).expect("a wrapping image");
+                    for (lane, &uv) in uv.iter().enumerate() {
+                        let ctx = TexCtx { uv, duv_dx, duv_dy, uv_mirrored: None };
+                        let lanes = [r, g, b].map(|c| c.to_array()[lane].to_bits());
+                        let one = image.eval(&ctx).truncate().to_array().map(f32::to_bits);
+                        assert_eq!(lanes, one, "{channels} channels, {filter:?} {duv_dx} {uv}");
                     }
-                });
-                let values = image.eval_prepared_x4(uv, &footprint).expect("a wrapping image");
-                for (&uv, value) in uv.iter().zip(values) {
-                    let ctx = TexCtx { uv, duv_dx: Vec2::ZERO, duv_dy: Vec2::ZERO, uv_mirrored: None };
-                    let bits = |v: Vec4| v.to_array().map(f32::to_bits);
-                    assert_eq!(bits(value), bits(image.eval(&ctx)), "{filter:?} {uv}");
                 }
             }
         }
