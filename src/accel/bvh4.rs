@@ -15,6 +15,10 @@
 //! Leaves whose triangles all emit and lie in one plane (a quad light) keep that plane, and shadow
 //! rays that stay clear of it skip their triangle tests (`leaf_plane.rs`).
 //!
+//! The queries are written to inline, their leaf closures with them, into the batches of
+//! `Queries` (`super::Queries::intersect_many`), which run compiled for the lanes' instruction
+//! set: a closure or iterator left out of line would run without it.
+//!
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
 //! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches.
 
@@ -235,31 +239,34 @@ fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
         by_octant[r.d.cmplt(Vec3::ZERO).bitmask() as usize] |= 1 << i;
     }
     let mut octant = 0;
-    std::iter::from_fn(move || {
-        while by_octant[octant] == 0 {
-            octant += 1;
-            if octant == 8 {
-                return None;
+    std::iter::from_fn(
+        #[inline(always)]
+        move || {
+            while by_octant[octant] == 0 {
+                octant += 1;
+                if octant == 8 {
+                    return None;
+                }
             }
-        }
-        let remaining = by_octant[octant];
-        let first = remaining.trailing_zeros() as usize;
-        let mut group = 1u32 << first;
-        let d = rays[first].d;
-        // d_i . d >= COHERENT_COS |d_i| |d|, squared (in one octant, d_i . d is not negative).
-        let bound = COHERENT_COS * COHERENT_COS * d.length_squared();
-        for i in set_bits(remaining & (remaining - 1)) {
-            if group.count_ones() == PACKET_SIZE as u32 {
-                break;
+            let remaining = by_octant[octant];
+            let first = remaining.trailing_zeros() as usize;
+            let mut group = 1u32 << first;
+            let d = rays[first].d;
+            // d_i . d >= COHERENT_COS |d_i| |d|, squared (in one octant, d_i . d is not negative).
+            let bound = COHERENT_COS * COHERENT_COS * d.length_squared();
+            for i in set_bits(remaining & (remaining - 1)) {
+                if group.count_ones() == PACKET_SIZE as u32 {
+                    break;
+                }
+                let dot = rays[i].d.dot(d);
+                if dot * dot >= bound * rays[i].d.length_squared() {
+                    group |= 1 << i;
+                }
             }
-            let dot = rays[i].d.dot(d);
-            if dot * dot >= bound * rays[i].d.length_squared() {
-                group |= 1 << i;
-            }
-        }
-        by_octant[octant] &= !group;
-        Some(group)
-    })
+            by_octant[octant] &= !group;
+            Some(group)
+        },
+    )
 }
 
 impl Bvh4 {
@@ -292,38 +299,59 @@ impl Bvh4 {
     }
 
     /// The closest hit with `0 < t < ray.t_max`.
+    #[inline(always)]
     pub(super) fn intersect(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<Hit> {
         let shear = RayShear::new(ray);
         let mut closest: Option<Hit> = None;
-        self.traverse::<true>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
-            for p in leaf.packets() {
-                let packet = &self.packets[p];
-                if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
-                    closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
-                    *t_max = t;
+        self.traverse::<true>(
+            &RayBoxes::new(ray),
+            ray.t_max,
+            stack,
+            #[inline(always)]
+            |leaf, t_max| {
+                for p in leaf.packets() {
+                    let packet = &self.packets[p];
+                    if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
+                        closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
+                        *t_max = t;
+                    }
                 }
-            }
-            false
-        });
+                false
+            },
+        );
         closest
     }
 
     /// Whether anything lies on the ray with `0 < t < ray.t_max`.
+    #[inline(always)]
     pub(super) fn occluded(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
         let shear = RayShear::new(ray);
         let mut blocked = false;
-        self.traverse::<false>(&RayBoxes::new(ray), ray.t_max, stack, |leaf, t_max| {
-            if leaf.plane != NO_PLANE && self.planes[leaf.plane as usize].clears(ray, *t_max) {
-                return false;
-            }
-            blocked = leaf.packets().any(|p| shear.occludes(&self.packets[p].triangles, *t_max));
-            blocked
-        });
+        self.traverse::<false>(
+            &RayBoxes::new(ray),
+            ray.t_max,
+            stack,
+            #[inline(always)]
+            |leaf, t_max| {
+                if leaf.plane != NO_PLANE && self.planes[leaf.plane as usize].clears(ray, *t_max) {
+                    return false;
+                }
+                // A loop, not `Iterator::any`, which LLVM leaves out of line (see `Isa::run`).
+                for p in leaf.packets() {
+                    if shear.occludes(&self.packets[p].triangles, *t_max) {
+                        blocked = true;
+                        break;
+                    }
+                }
+                blocked
+            },
+        );
         blocked
     }
 
     /// The closest hit of each ray of `rays` (at most 32), as [`Bvh4::intersect`] gives it but
     /// for ties in distance; coherent rays are traced as packets.
+    #[inline(always)]
     pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], stack: &mut TraversalStack) {
         for group in coherent_groups(rays) {
             if group.count_ones() == 1 {
@@ -343,6 +371,7 @@ impl Bvh4 {
     /// The closest hits of the rays of `group` (a bit mask into `rays`, at most `N` set;
     /// directions in one octant), traversing once for all. Each ray meets the triangles of the
     /// leaves it enters with the same test as alone.
+    #[inline(always)]
     fn intersect_coherent<const N: usize>(
         &self,
         rays: &[Ray],
@@ -357,28 +386,37 @@ impl Bvh4 {
         for (slot, i) in index.iter_mut().zip(set_bits(group)) {
             *slot = i;
         }
-        let packet = index.map(|i| CoherentRay::new(&rays[i]));
+        let packet: [CoherentRay; N] = std::array::from_fn(
+            #[inline(always)]
+            |k| CoherentRay::new(&rays[index[k]]),
+        );
         let mut t_max = index.map(|i| rays[i].t_max);
         for &i in &index[..n] {
             hits[i] = None;
         }
         let farthest = |t: &[f32]| t.iter().fold(0.0f32, |a, &b| a.max(b));
-        self.traverse::<true>(&PacketBoxes::new(&packet[..n]), farthest(&t_max[..n]), stack, |leaf, packet_t_max| {
-            for (k, ray) in packet[..n].iter().enumerate() {
-                if !ray.enters(leaf, t_max[k]) {
-                    continue;
-                }
-                for p in leaf.packets() {
-                    let packet = &self.packets[p];
-                    if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&packet.triangles, t_max[k]) {
-                        hits[index[k]] = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
-                        t_max[k] = t;
+        self.traverse::<true>(
+            &PacketBoxes::new(&packet[..n]),
+            farthest(&t_max[..n]),
+            stack,
+            #[inline(always)]
+            |leaf, packet_t_max| {
+                for (k, ray) in packet[..n].iter().enumerate() {
+                    if !ray.enters(leaf, t_max[k]) {
+                        continue;
+                    }
+                    for p in leaf.packets() {
+                        let packet = &self.packets[p];
+                        if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&packet.triangles, t_max[k]) {
+                            hits[index[k]] = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
+                            t_max[k] = t;
+                        }
                     }
                 }
-            }
-            *packet_t_max = farthest(&t_max[..n]);
-            false
-        });
+                *packet_t_max = farthest(&t_max[..n]);
+                false
+            },
+        );
     }
 
     /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(leaf, t_max)`, which may

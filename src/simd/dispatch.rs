@@ -1,6 +1,6 @@
-//! The instruction set that lane code runs with, chosen at run time: AVX2 where the CPU has
-//! it, else the baseline (SSE2 on x86-64, whatever the target has elsewhere). Either can be
-//! asked for, so that tests and benchmarks compare them.
+//! The instruction set that lane code (and batches of ray queries) runs with, chosen at run
+//! time: AVX2 where the CPU has it, else the baseline (SSE2 on x86-64, whatever the target has
+//! elsewhere). Either can be asked for, so that tests and benchmarks compare them.
 
 /// An instruction set for lane code ([`Isa::run`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
