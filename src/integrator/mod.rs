@@ -108,17 +108,18 @@ pub fn render_samples(
     let done = AtomicU64::new(0);
     let tiles: Vec<(u32, u32)> =
         (0..h.div_ceil(TILE)).flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx, ty))).collect();
-    tiles.par_iter().for_each(|&(tx, ty)| {
+    // Each worker's buffers are kept from tile to tile (grown once, not for every tile).
+    let worker_buffers = || (Vec::new(), vec![0.0f32; stride], Vec::new(), WaveBuffers::default(), Vec::new());
+    tiles.par_iter().for_each_init(worker_buffers, |(pixels, aov_buf, paths, buffers, tile_pixels), &(tx, ty)| {
         if stop.load(Ordering::Relaxed) {
             return;
         }
-        let mut pixels = Vec::with_capacity((TILE * TILE) as usize);
-        let mut aov_buf = vec![0.0f32; stride];
-        let mut paths = Vec::new();
-        let mut buffers = WaveBuffers::default();
-        let tile_pixels: Vec<(u32, u32)> = (ty * TILE..((ty + 1) * TILE).min(h))
-            .flat_map(|fy| (tx * TILE..((tx + 1) * TILE).min(w)).map(move |fx| (fx, fy)))
-            .collect();
+        pixels.clear();
+        tile_pixels.clear();
+        tile_pixels.extend(
+            (ty * TILE..((ty + 1) * TILE).min(h))
+                .flat_map(|fy| (tx * TILE..((tx + 1) * TILE).min(w)).map(move |fx| (fx, fy))),
+        );
         // Whole pixels at a time, about WAVE paths, are traced as one wavefront; then each
         // pixel's samples are added to its sums in order.
         let pixels_per_wave = (WAVE / samples.len().max(1)).max(1);
@@ -137,13 +138,13 @@ pub fn render_samples(
                     paths.push(tracer.start(ray, diff, sampler));
                 }
             }
-            tracer.trace_wave(&mut paths, &mut buffers);
+            tracer.trace_wave(paths, buffers);
             for (&(fx, fy), pixel_paths) in wave.iter().zip(paths.chunks(samples.len().max(1))) {
                 let mut sum = film.pixel(fx as usize, fy as usize).clone();
                 for path in pixel_paths {
                     let l = path.radiance;
-                    aov_values(aovs, &path.first_hit, &mut aov_buf);
-                    sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), &aov_buf);
+                    aov_values(aovs, &path.first_hit, aov_buf);
+                    sum.add(if l.is_finite() { l } else { Rgb::ZERO }, !l.is_finite(), aov_buf);
                 }
                 pixels.push((fx as usize, fy as usize, sum));
             }
@@ -151,7 +152,7 @@ pub fn render_samples(
         let taken = pixels.len() as u64 * spp;
         {
             let mut next = next.lock().expect("no panics while holding the film");
-            for (x, y, sum) in pixels {
+            for (x, y, sum) in pixels.drain(..) {
                 next.set_pixel(x, y, sum);
             }
         }
