@@ -24,8 +24,9 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 const TILE: u32 = 16;
 
 /// About this many paths are traced as one wavefront ([`PathTracer::trace_wave`]): whole
-/// pixels' samples, at least one pixel's.
-const WAVE: usize = 256;
+/// pixels' samples, at least one pixel's. Waves of 1,024 fill the lanes' groups of eight better
+/// than waves of 256 at every bounce (scene A 0.7% fewer instructions, the Cornell box 1.6%).
+const WAVE: usize = 1024;
 
 /// A rectangle of pixels `[x0, x1) x [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
