@@ -284,7 +284,8 @@ fn wrapped_texels_x4(st: Vec4, n: f32) -> ([IVec4; 2], Vec4) {
 /// level's `texels`, as a vector per pick.
 #[inline(always)]
 fn channels_x4<const C: usize, const N: usize>(texels: &[[f32; C]], offsets: IVec4, picks: [usize; N]) -> [Vec4; N] {
-    // Lane by lane: `array::map` is a call that LLVM leaves out of line here.
+    // Lane by lane: an `array::map` over the lanes was a call that LLVM left out of line (the
+    // picks, two or three, are mapped).
     let (a, b, c, d) = (
         texels[offsets.x as usize],
         texels[offsets.y as usize],
