@@ -308,11 +308,11 @@ impl PathTracer<'_> {
             let uv = std::array::from_fn(|l| Vec2::new(s.uv[0].0[quad + l], s.uv[1].0[quad + l]));
             let [r, g, b] = image.eval_rgb_x4(uv, &footprint)?;
             // Each lane's colour times the scale, channel by channel, as `ColorParam::eval`.
-            for (lanes, (value, scale)) in [&mut reflectances.x, &mut reflectances.y, &mut reflectances.z]
-                .into_iter()
-                .zip([(r, scale.x), (g, scale.y), (b, scale.z)])
+            let scaled = [r * scale.x, g * scale.y, b * scale.z];
+            for (lanes, value) in
+                [&mut reflectances.x, &mut reflectances.y, &mut reflectances.z].into_iter().zip(scaled)
             {
-                lanes.0[quad..quad + 4].copy_from_slice(&(value * scale).to_array());
+                lanes.0[quad..quad + 4].copy_from_slice(&value.to_array());
             }
         }
         Some(reflectances)
