@@ -635,6 +635,40 @@ mod tests {
     use super::*;
 
     #[test]
+    fn unused_slots_are_entered_by_no_ray_and_the_used_one_by_rays_through_it() {
+        // One triangle, whose box is the unit cube: the root holds its leaf in one slot and
+        // three unused ones.
+        let bvh = crate::accel::build_bvh4(&[[Vec3::ZERO, Vec3::new(1.0, 0.0, 0.5), Vec3::new(0.0, 1.0, 1.0)]], &[]);
+        let root = &bvh.nodes[0];
+        let used = root.bounds[0].cmplt(Vec4::INFINITY).bitmask();
+        assert_eq!(used.count_ones(), 1);
+        // Directions of every sign, zeros of both signs among them, from origins all round, with
+        // no hit yet (t_max infinite, as camera and bounce rays start).
+        let components = [-1.0, -0.3, -0.0, 0.0, 0.4, 1.0];
+        for &x in &components {
+            for &y in &components {
+                for &z in &components {
+                    let d = Vec3::new(x, y, z);
+                    if d.length_squared() == 0.0 {
+                        continue;
+                    }
+                    for o in [Vec3::splat(-5.0), Vec3::new(3.0, -2.0, 7.0), Vec3::splat(0.25), Vec3::splat(1e6)] {
+                        let (mask, _) = RayBoxes::new(&Ray::new(o, d)).test(root, f32::INFINITY);
+                        assert_eq!(mask & !used, 0, "an unused slot entered from {o} along {d}");
+                        let packet = [CoherentRay::new(&Ray::new(o, d)), CoherentRay::new(&Ray::new(o + 0.01, d))];
+                        let (mask, _) = PacketBoxes::new(&packet).test(root, f32::INFINITY);
+                        assert_eq!(mask & !used, 0, "an unused slot entered by a packet from {o} along {d}");
+                    }
+                    // Aimed through a point inside the box, from outside it.
+                    let inside = Vec3::new(0.3, 0.3, 0.4);
+                    let (mask, _) = RayBoxes::new(&Ray::new(inside - d * 10.0, d)).test(root, f32::INFINITY);
+                    assert_eq!(mask, used, "the box missed along {d}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
         let tris = crate::accel::tests::lopsided_scene();
         let bvh = crate::accel::build_bvh4(&tris, &[]);
