@@ -20,7 +20,8 @@
 //! set: a closure or iterator left out of line would run without it.
 //!
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
-//! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches.
+//! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches (a
+//! single ray's through a reciprocal enlarged once per ray, as Ize does).
 
 use super::leaf_plane::LeafPlane;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
@@ -87,9 +88,10 @@ pub(super) struct Bvh4 {
 struct RayBoxes {
     /// Per axis, 1 when the near plane is the max plane (a negative direction), else 0.
     near_is_max: [usize; 3],
+    origin: [Vec4; 3],
     inv_d: [Vec4; 3],
-    /// origin / direction, per axis.
-    o_inv_d: [Vec4; 3],
+    /// `inv_d` enlarged by [`ROBUST_FAR`], for the far planes (Ize 2013).
+    inv_d_far: [Vec4; 3],
 }
 
 /// A test of the four child boxes of a node: bit i of the mask set when the ray (or some ray of
@@ -118,11 +120,13 @@ fn near_is_max(inv_d: Vec3A) -> [usize; 3] {
 impl RayBoxes {
     fn new(ray: &Ray) -> Self {
         let inv_d = safe_reciprocal(ray.d);
-        let o_inv_d = Vec3A::from(ray.o) * inv_d;
+        let inv_d_far = inv_d * ROBUST_FAR;
+        let splat = |v: Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
         RayBoxes {
             near_is_max: near_is_max(inv_d),
-            inv_d: [Vec4::splat(inv_d.x), Vec4::splat(inv_d.y), Vec4::splat(inv_d.z)],
-            o_inv_d: [Vec4::splat(o_inv_d.x), Vec4::splat(o_inv_d.y), Vec4::splat(o_inv_d.z)],
+            origin: splat(ray.o.into()),
+            inv_d: splat(inv_d),
+            inv_d_far: splat(inv_d_far),
         }
     }
 }
@@ -130,15 +134,17 @@ impl RayBoxes {
 impl BoxTest for RayBoxes {
     #[inline(always)]
     fn test(&self, node: &Node, t_max: f32) -> (u32, Vec4) {
-        // Distance to the near (far: `max_side` 1) plane along `axis`; `& 1` keeps the index
+        // Distance to the near (far: `max_side` 1) plane along `axis`, as Ize computes it: the
+        // difference, then the product, by the enlarged reciprocal for the far plane, so that
+        // the enlargement bounds the rounding and costs nothing per node. `& 1` keeps the index
         // provably in bounds.
-        let slab = |axis: usize, max_side: usize| {
-            node.bounds[2 * axis + (max_side & 1)] * self.inv_d[axis] - self.o_inv_d[axis]
-        };
+        let plane = |axis: usize, max_side: usize| node.bounds[2 * axis + (max_side & 1)] - self.origin[axis];
         let [nx, ny, nz] = self.near_is_max;
-        let t_near = slab(0, nx).max(slab(1, ny)).max(slab(2, nz).max(Vec4::ZERO));
-        let t_far = slab(0, nx ^ 1).min(slab(1, ny ^ 1)).min(slab(2, nz ^ 1).min(Vec4::splat(t_max)));
-        (t_near.cmple(t_far * ROBUST_FAR).bitmask(), t_near)
+        let near = |axis: usize, side: usize| plane(axis, side) * self.inv_d[axis];
+        let far = |axis: usize, side: usize| plane(axis, side ^ 1) * self.inv_d_far[axis];
+        let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
+        let t_far = far(0, nx).min(far(1, ny)).min(far(2, nz).min(Vec4::splat(t_max)));
+        (t_near.cmple(t_far).bitmask(), t_near)
     }
 }
 
