@@ -110,6 +110,12 @@ fn safe_reciprocal(d: Vec3) -> Vec3A {
     Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d).recip()
 }
 
+/// Each component of `v` in all four lanes, per axis: the per-ray constants of a box test.
+#[inline(always)]
+fn splat_axes(v: Vec3A) -> [Vec4; 3] {
+    [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)]
+}
+
 /// Per axis, 1 when the near plane is the max plane (a negative direction), else 0.
 #[inline(always)]
 fn near_is_max(inv_d: Vec3A) -> [usize; 3] {
@@ -120,13 +126,11 @@ fn near_is_max(inv_d: Vec3A) -> [usize; 3] {
 impl RayBoxes {
     fn new(ray: &Ray) -> Self {
         let inv_d = safe_reciprocal(ray.d);
-        let inv_d_far = inv_d * ROBUST_FAR;
-        let splat = |v: Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
         RayBoxes {
             near_is_max: near_is_max(inv_d),
-            origin: splat(ray.o.into()),
-            inv_d: splat(inv_d),
-            inv_d_far: splat(inv_d_far),
+            origin: splat_axes(ray.o.into()),
+            inv_d: splat_axes(inv_d),
+            inv_d_far: splat_axes(inv_d * ROBUST_FAR),
         }
     }
 }
@@ -174,13 +178,12 @@ impl PacketBoxes {
         // One octant: a negative lower end means every reciprocal on that axis is negative.
         let negative = inv_lo.cmplt(Vec3A::ZERO);
         let (o_near, o_far) = (Vec3A::select(negative, o_lo, o_hi), Vec3A::select(negative, o_hi, o_lo));
-        let splat = |v: Vec3A| [Vec4::splat(v.x), Vec4::splat(v.y), Vec4::splat(v.z)];
         PacketBoxes {
             near_is_max: near_is_max(inv_lo),
-            inv_lo: splat(inv_lo),
-            inv_hi: splat(inv_hi),
-            o_near: splat(o_near),
-            o_far: splat(o_far),
+            inv_lo: splat_axes(inv_lo),
+            inv_hi: splat_axes(inv_hi),
+            o_near: splat_axes(o_near),
+            o_far: splat_axes(o_far),
         }
     }
 }
