@@ -12,6 +12,10 @@
 //! whose box test bounds all its rays by interval arithmetic, with each ray's own box and
 //! triangle tests at the leaves (`intersect_many`).
 //!
+//! Incoherent rays (the wavefront's bounce and shadow rays) are traced two at a time, their
+//! traversals advanced step by step in turn (`interleave`), so that one ray's box tests fill the
+//! time the other waits on its node.
+//!
 //! Leaves whose triangles all emit and lie in one plane (a quad light) keep that plane, and shadow
 //! rays that stay clear of it skip their triangle tests (`leaf_plane.rs`).
 //!
@@ -318,13 +322,7 @@ impl Bvh4 {
             stack,
             #[inline(always)]
             |leaf, t_max| {
-                for p in leaf.packets() {
-                    let packet = &self.packets[p];
-                    if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
-                        closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
-                        *t_max = t;
-                    }
-                }
+                self.closest_in_leaf(&shear, leaf, t_max, &mut closest);
                 false
             },
         );
@@ -342,20 +340,92 @@ impl Bvh4 {
             stack,
             #[inline(always)]
             |leaf, t_max| {
-                if leaf.plane != NO_PLANE && self.planes[leaf.plane as usize].clears(ray, *t_max) {
-                    return false;
-                }
-                // A loop, not `Iterator::any`, which LLVM leaves out of line (see `Isa::run`).
-                for p in leaf.packets() {
-                    if shear.occludes(&self.packets[p].triangles, *t_max) {
-                        blocked = true;
-                        break;
-                    }
-                }
+                blocked = self.blocks_in_leaf(ray, &shear, leaf, *t_max);
                 blocked
             },
         );
         blocked
+    }
+
+    /// The closest hit of each of `rays` into `hits`, as [`Bvh4::intersect`] gives it, two rays'
+    /// traversals interleaved ([`interleave`]).
+    #[inline(always)]
+    pub(super) fn intersect_each(&self, rays: &[Ray], hits: &mut [Option<Hit>], stacks: &mut [TraversalStack; 2]) {
+        interleave(
+            rays.len(),
+            stacks,
+            #[inline(always)]
+            |i| Query::new(rays, i, None),
+            #[inline(always)]
+            |q, stack| {
+                self.step::<true>(
+                    &q.boxes,
+                    &mut q.walk,
+                    stack,
+                    #[inline(always)]
+                    |leaf, t_max| {
+                        self.closest_in_leaf(&q.shear, leaf, t_max, &mut q.answer);
+                        false
+                    },
+                )
+            },
+            #[inline(always)]
+            |q| hits[q.ray] = q.answer,
+        );
+    }
+
+    /// Whether each of `rays` is blocked, into `blocked`, as [`Bvh4::occluded`] answers, two
+    /// rays' traversals interleaved ([`interleave`]).
+    #[inline(always)]
+    pub(super) fn occluded_each(&self, rays: &[Ray], blocked: &mut [bool], stacks: &mut [TraversalStack; 2]) {
+        interleave(
+            rays.len(),
+            stacks,
+            #[inline(always)]
+            |i| Query::new(rays, i, false),
+            #[inline(always)]
+            |q, stack| {
+                self.step::<false>(
+                    &q.boxes,
+                    &mut q.walk,
+                    stack,
+                    #[inline(always)]
+                    |leaf, t_max| {
+                        q.answer = self.blocks_in_leaf(&rays[q.ray], &q.shear, leaf, *t_max);
+                        q.answer
+                    },
+                )
+            },
+            #[inline(always)]
+            |q| blocked[q.ray] = q.answer,
+        );
+    }
+
+    /// Shorten `t_max` and `closest` to the closest hit of the ray (`shear`) in `leaf`.
+    #[inline(always)]
+    fn closest_in_leaf(&self, shear: &RayShear, leaf: &Leaf, t_max: &mut f32, closest: &mut Option<Hit>) {
+        for p in leaf.packets() {
+            let packet = &self.packets[p];
+            if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
+                *closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
+                *t_max = t;
+            }
+        }
+    }
+
+    /// Whether a triangle of `leaf` lies on `ray` (`shear`) before `t_max`.
+    #[inline(always)]
+    fn blocks_in_leaf(&self, ray: &Ray, shear: &RayShear, leaf: &Leaf, t_max: f32) -> bool {
+        if leaf.plane != NO_PLANE && self.planes[leaf.plane as usize].clears(ray, t_max) {
+            return false;
+        }
+        // A loop, not `Iterator::any`, which LLVM leaves out of line (see `Isa::run`).
+        for p in leaf.packets() {
+            if shear.occludes(&self.packets[p].triangles, t_max) {
+                return true;
+            }
+        }
+        false
     }
 
     /// The closest hit of each ray of `rays` (at most 32), as [`Bvh4::intersect`] gives it but
@@ -436,79 +506,188 @@ impl Bvh4 {
     fn traverse<const CLOSEST: bool>(
         &self,
         boxes: &impl BoxTest,
-        mut t_max: f32,
+        t_max: f32,
         stack: &mut TraversalStack,
         mut leaf: impl FnMut(&Leaf, &mut f32) -> bool,
     ) {
         stack.clear();
-        let mut current = 0u32;
-        loop {
-            if current & LEAF == 0 {
-                let node = &self.nodes[current as usize];
-                let (mut mask, t_near) = boxes.test(node, t_max);
-                if mask != 0 {
-                    let t_near = t_near.to_array();
-                    if mask & (mask - 1) == 0 {
-                        current = node.children[mask.trailing_zeros() as usize];
-                        continue;
-                    }
-                    let mut rest = mask & (mask - 1);
-                    if !CLOSEST {
-                        // Any order: visit the first, push the others.
-                        current = node.children[mask.trailing_zeros() as usize];
-                        while rest != 0 {
-                            let i = rest.trailing_zeros() as usize;
-                            rest &= rest - 1;
-                            stack.push((node.children[i], 0.0));
-                        }
-                        continue;
-                    }
-                    if rest & (rest - 1) == 0 {
-                        // Two: visit the nearer, push the other (the order the sort below
-                        // would give, ties included).
-                        let (i, j) = (mask.trailing_zeros() as usize, rest.trailing_zeros() as usize);
-                        let (near, far) = if t_near[i] < t_near[j] { (i, j) } else { (j, i) };
-                        stack.push((node.children[far], t_near[far]));
-                        current = node.children[near];
-                        continue;
-                    }
-                    // Three or four: push all but the nearest, farthest first.
-                    let mut hits = [(0u32, 0.0f32); 4];
-                    let mut n = 0;
-                    while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        hits[n] = (node.children[i], t_near[i]);
-                        n += 1;
-                    }
-                    // Insertion sort, farthest first; stable, so that ties keep child order.
-                    for i in 1..n {
-                        let mut j = i;
-                        while j > 0 && hits[j - 1].1 < hits[j].1 {
-                            hits.swap(j - 1, j);
-                            j -= 1;
-                        }
-                    }
-                    stack.extend_from_slice(&hits[..n - 1]);
-                    current = hits[n - 1].0;
-                    continue;
+        let mut walk = Walk::new(t_max);
+        while self.step::<CLOSEST>(
+            boxes,
+            &mut walk,
+            stack,
+            #[inline(always)]
+            |node, t_max| leaf(node, t_max),
+        ) {}
+    }
+
+    /// One step of [`Bvh4::traverse`]: visit `walk`'s node or leaf and move it to the next one;
+    /// false when the traversal has ended.
+    #[inline(always)]
+    fn step<const CLOSEST: bool>(
+        &self,
+        boxes: &impl BoxTest,
+        walk: &mut Walk,
+        stack: &mut TraversalStack,
+        leaf: impl FnOnce(&Leaf, &mut f32) -> bool,
+    ) -> bool {
+        let current = walk.current;
+        if current & LEAF == 0 {
+            let node = &self.nodes[current as usize];
+            let (mut mask, t_near) = boxes.test(node, walk.t_max);
+            if mask != 0 {
+                let t_near = t_near.to_array();
+                if mask & (mask - 1) == 0 {
+                    walk.current = node.children[mask.trailing_zeros() as usize];
+                    return true;
                 }
-            } else {
-                if leaf(&self.leaves[(current & !LEAF) as usize], &mut t_max) {
-                    return;
+                let mut rest = mask & (mask - 1);
+                if !CLOSEST {
+                    // Any order: visit the first, push the others.
+                    walk.current = node.children[mask.trailing_zeros() as usize];
+                    while rest != 0 {
+                        let i = rest.trailing_zeros() as usize;
+                        rest &= rest - 1;
+                        stack.push((node.children[i], 0.0));
+                    }
+                    return true;
                 }
+                if rest & (rest - 1) == 0 {
+                    // Two: visit the nearer, push the other (the order the sort below
+                    // would give, ties included).
+                    let (i, j) = (mask.trailing_zeros() as usize, rest.trailing_zeros() as usize);
+                    let (near, far) = if t_near[i] < t_near[j] { (i, j) } else { (j, i) };
+                    stack.push((node.children[far], t_near[far]));
+                    walk.current = node.children[near];
+                    return true;
+                }
+                // Three or four: push all but the nearest, farthest first.
+                let mut hits = [(0u32, 0.0f32); 4];
+                let mut n = 0;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    hits[n] = (node.children[i], t_near[i]);
+                    n += 1;
+                }
+                // Insertion sort, farthest first; stable, so that ties keep child order.
+                for i in 1..n {
+                    let mut j = i;
+                    while j > 0 && hits[j - 1].1 < hits[j].1 {
+                        hits.swap(j - 1, j);
+                        j -= 1;
+                    }
+                }
+                stack.extend_from_slice(&hits[..n - 1]);
+                walk.current = hits[n - 1].0;
+                return true;
             }
-            // Next: the nearest entry on the stack that is not beyond the closest hit.
-            loop {
-                let Some((next, t_near)) = stack.pop() else {
-                    return;
-                };
-                if !CLOSEST || t_near <= t_max {
-                    current = next;
-                    break;
-                }
+        } else if leaf(&self.leaves[(current & !LEAF) as usize], &mut walk.t_max) {
+            return false;
+        }
+        // Next: the nearest entry on the stack that is not beyond the closest hit.
+        loop {
+            let Some((next, t_near)) = stack.pop() else {
+                return false;
+            };
+            if !CLOSEST || t_near <= walk.t_max {
+                walk.current = next;
+                return true;
             }
         }
+    }
+}
+
+/// One ray's query in progress ([`interleave`]): the ray's index, its per-ray constants, where
+/// its traversal stands, and its answer so far (`A`: the closest hit, or whether it is blocked).
+struct Query<A> {
+    ray: usize,
+    boxes: RayBoxes,
+    shear: RayShear,
+    walk: Walk,
+    answer: A,
+}
+
+impl<A> Query<A> {
+    /// The query of ray `i` of `rays`, at the root, its answer `answer` until it finds another.
+    #[inline(always)]
+    fn new(rays: &[Ray], i: usize, answer: A) -> Self {
+        let ray = &rays[i];
+        Query { ray: i, boxes: RayBoxes::new(ray), shear: RayShear::new(ray), walk: Walk::new(ray.t_max), answer }
+    }
+}
+
+/// Run `count` queries two at a time, their steps interleaved: query `i` starts as `start(i)`,
+/// advances by `step(query, its stack)` until that returns false, and hands its answer to
+/// `finish`; a finished query's place goes to the next. A traversal step is a chain of dependent
+/// loads and tests, which leaves the core idle while one ray waits on its node; the other ray's
+/// steps fill that time. Each query takes the steps it takes alone, so gives the same answer.
+/// (Two queries in named variables: held in an array, indexed in a loop, they ran slower, and
+/// so did four.)
+#[inline(always)]
+fn interleave<Q>(
+    count: usize,
+    stacks: &mut [TraversalStack; 2],
+    start: impl Fn(usize) -> Q,
+    mut step: impl FnMut(&mut Q, &mut TraversalStack) -> bool,
+    mut finish: impl FnMut(&Q),
+) {
+    let [stack_a, stack_b] = stacks;
+    if count < 2 {
+        for i in 0..count {
+            let mut query = start(i);
+            stack_a.clear();
+            while step(&mut query, stack_a) {}
+            finish(&query);
+        }
+        return;
+    }
+    let (mut a, mut b) = (start(0), start(1));
+    stack_a.clear();
+    stack_b.clear();
+    let mut next = 2;
+    loop {
+        let a_goes_on = step(&mut a, stack_a);
+        let b_goes_on = step(&mut b, stack_b);
+        if !a_goes_on {
+            finish(&a);
+            if next == count {
+                // No query left to start: the other runs to its end.
+                if b_goes_on {
+                    while step(&mut b, stack_b) {}
+                }
+                finish(&b);
+                return;
+            }
+            a = start(next);
+            stack_a.clear();
+            next += 1;
+        }
+        if !b_goes_on {
+            finish(&b);
+            if next == count {
+                while step(&mut a, stack_a) {}
+                finish(&a);
+                return;
+            }
+            b = start(next);
+            stack_b.clear();
+            next += 1;
+        }
+    }
+}
+
+/// Where a traversal stands ([`Bvh4::step`]): the node (or `LEAF | leaf`) to visit next, and the
+/// distance beyond which nothing is looked for.
+struct Walk {
+    current: u32,
+    t_max: f32,
+}
+
+impl Walk {
+    /// A traversal from the root.
+    fn new(t_max: f32) -> Self {
+        Walk { current: 0, t_max }
     }
 }
 

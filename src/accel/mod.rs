@@ -123,14 +123,14 @@ impl Accel {
         }
     }
 
-    /// Run `f` with ray queries that share this thread's traversal stack: a batch of queries
+    /// Run `f` with ray queries that share this thread's traversal stacks: a batch of queries
     /// (a stage of the wavefront) takes it once, rather than once per ray.
     #[inline]
     pub fn queries<R>(&self, f: impl FnOnce(&mut Queries<'_>) -> R) -> R {
-        TRAVERSAL_STACK.with(|cell| match cell.try_borrow_mut() {
-            Ok(mut stack) => f(&mut Queries { accel: self, stack: &mut stack }),
-            // Queries started inside `f` (none of tessera's do) get a stack of their own.
-            Err(_) => f(&mut Queries { accel: self, stack: &mut Vec::new() }),
+        TRAVERSAL_STACKS.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stacks) => f(&mut Queries { accel: self, stacks: &mut stacks }),
+            // Queries started inside `f` (none of tessera's do) get stacks of their own.
+            Err(_) => f(&mut Queries { accel: self, stacks: &mut Default::default() }),
         })
     }
 
@@ -174,10 +174,10 @@ impl Accel {
     }
 }
 
-/// Ray queries into an [`Accel`] that share one traversal stack ([`Accel::queries`]).
+/// Ray queries into an [`Accel`] that share the traversal stacks of a thread ([`Accel::queries`]).
 pub struct Queries<'a> {
     accel: &'a Accel,
-    stack: &'a mut TraversalStack,
+    stacks: &'a mut [TraversalStack; 2],
 }
 
 impl Queries<'_> {
@@ -187,7 +187,7 @@ impl Queries<'_> {
         let accel = self.accel;
         let triangle = match &accel.backend {
             Backend::Empty => None,
-            Backend::Bvh4(bvh) => bvh.intersect(ray, self.stack),
+            Backend::Bvh4(bvh) => bvh.intersect(ray, &mut self.stacks[0]),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.intersect(ray),
         };
@@ -208,7 +208,7 @@ impl Queries<'_> {
                 for (rays, hits) in rays.chunks(32).zip(hits.chunks_mut(32)) {
                     match &accel.backend {
                         Backend::Bvh4(bvh) => {
-                            bvh.intersect_many(rays, hits, self.stack);
+                            bvh.intersect_many(rays, hits, &mut self.stacks[0]);
                             for (r, h) in rays.iter().zip(hits) {
                                 *h = accel.closer_sphere(r, *h);
                             }
@@ -225,55 +225,51 @@ impl Queries<'_> {
     }
 
     /// The closest hit of each of `rays` into `hits` (of the same length), as
-    /// [`Queries::intersect`] gives it; Embree traces them eight at a time, as packets (the
-    /// four-wide BVH one at a time: packets of rays that diverge measured slower).
+    /// [`Queries::intersect`] gives it; Embree traces them eight at a time, as packets, the
+    /// four-wide BVH two at a time, their traversals interleaved (packets of rays that diverge
+    /// measured slower).
     pub fn intersect_each(&mut self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit per ray");
         let accel = self.accel;
         match &accel.backend {
+            Backend::Empty => hits.fill(None),
+            Backend::Bvh4(bvh) => Isa::selected().run(
+                #[inline(always)]
+                || bvh.intersect_each(rays, hits, self.stacks),
+            ),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => {
                 for (rays, hits) in rays.chunks(embree::PACKET).zip(hits.chunks_mut(embree::PACKET)) {
                     scene.intersect8(rays, hits);
                 }
-                if accel.spheres.is_some() {
-                    rays.iter().zip(hits.iter_mut()).for_each(|(r, h)| *h = accel.closer_sphere(r, *h));
-                }
             }
-            _ => Isa::selected().run(
-                #[inline(always)]
-                || {
-                    for (r, h) in rays.iter().zip(hits) {
-                        *h = self.intersect(r);
-                    }
-                },
-            ),
+        }
+        if accel.spheres.is_some() {
+            rays.iter().zip(hits.iter_mut()).for_each(|(r, h)| *h = accel.closer_sphere(r, *h));
         }
     }
 
     /// Whether each of `rays` is blocked ([`Queries::occluded`]), into `blocked` (of the same
-    /// length); Embree tests them eight at a time as packets.
+    /// length); Embree tests them eight at a time as packets, the four-wide BVH two at a time,
+    /// their traversals interleaved.
     pub fn occluded_each(&mut self, rays: &[Ray], blocked: &mut [bool]) {
         assert_eq!(rays.len(), blocked.len(), "one answer per ray");
         let accel = self.accel;
         match &accel.backend {
+            Backend::Empty => blocked.fill(false),
+            Backend::Bvh4(bvh) => Isa::selected().run(
+                #[inline(always)]
+                || bvh.occluded_each(rays, blocked, self.stacks),
+            ),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => {
                 for (rays, blocked) in rays.chunks(embree::PACKET).zip(blocked.chunks_mut(embree::PACKET)) {
                     scene.occluded8(rays, blocked);
                 }
-                if let Some(spheres) = &accel.spheres {
-                    rays.iter().zip(blocked.iter_mut()).for_each(|(r, b)| *b = *b || spheres.occluded(r));
-                }
             }
-            _ => Isa::selected().run(
-                #[inline(always)]
-                || {
-                    for (r, b) in rays.iter().zip(blocked) {
-                        *b = self.occluded(r);
-                    }
-                },
-            ),
+        }
+        if let Some(spheres) = &accel.spheres {
+            rays.iter().zip(blocked.iter_mut()).for_each(|(r, b)| *b = *b || spheres.occluded(r));
         }
     }
 
@@ -283,7 +279,7 @@ impl Queries<'_> {
         let accel = self.accel;
         let triangle = match &accel.backend {
             Backend::Empty => false,
-            Backend::Bvh4(bvh) => bvh.occluded(ray, self.stack),
+            Backend::Bvh4(bvh) => bvh.occluded(ray, &mut self.stacks[0]),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.occluded(ray),
         };
@@ -295,9 +291,11 @@ impl Queries<'_> {
 type TraversalStack = Vec<(u32, f32)>;
 
 thread_local! {
-    /// Each thread's traversal stack, reused by every batch of queries so that none allocates
-    /// or initialises one.
-    static TRAVERSAL_STACK: std::cell::RefCell<TraversalStack> = const { std::cell::RefCell::new(Vec::new()) };
+    /// Each thread's traversal stacks (two, for the interleaved traversals of
+    /// [`Queries::intersect_each`]), reused by every batch of queries so that none allocates or
+    /// initialises one.
+    static TRAVERSAL_STACKS: std::cell::RefCell<[TraversalStack; 2]> =
+        const { std::cell::RefCell::new([Vec::new(), Vec::new()]) };
 }
 
 /// obvhs's binary BVH (leaves of up to four triangles: one packet), collapsed four-wide; the
@@ -305,7 +303,7 @@ thread_local! {
 fn build_bvh4(triangles: &[[Vec3; 3]], emitting: &[bool]) -> Bvh4 {
     let prims: Vec<Triangle> =
         triangles.iter().map(|t| Triangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
-    let params = BvhBuildParams { max_prims_per_leaf: 4, ..BvhBuildParams::medium_build() };
+    let params = BvhBuildParams { max_prims_per_leaf: 4, pre_split: false, ..BvhBuildParams::slow_build() };
     let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(&prims, params, &mut std::time::Duration::default());
     Bvh4::from_bvh2(&bvh2, triangles, emitting)
 }
@@ -512,7 +510,8 @@ mod tests {
                 // Stale answers in the output, which every query must overwrite.
                 let mut hits = vec![Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }); n];
                 accel.intersect_many(&rays, &mut hits);
-                // The wavefront's bounce and shadow queries: Embree's packets of eight.
+                // The wavefront's bounce and shadow queries: Embree's packets of eight, the
+                // four-wide BVH's interleaved pairs (odd counts end on one ray alone).
                 let mut each = hits.clone();
                 each.iter_mut().for_each(|h| *h = Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }));
                 let mut blocked = vec![true; n];
