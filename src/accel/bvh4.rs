@@ -31,6 +31,7 @@ use super::leaf_plane::LeafPlane;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
 use super::{Hit, TraversalStack};
 use crate::geometry::Ray;
+use crate::simd::set_bits;
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
@@ -689,16 +690,6 @@ impl Walk {
     fn new(t_max: f32) -> Self {
         Walk { current: 0, t_max }
     }
-}
-
-/// The indices of the bits set in `mask`, lowest first.
-#[inline(always)]
-fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        let i = (mask != 0).then_some(mask.trailing_zeros() as usize)?;
-        mask &= mask - 1;
-        Some(i)
-    })
 }
 
 /// Triangles under each node of a binary BVH.

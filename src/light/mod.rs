@@ -17,7 +17,7 @@ pub use environment::{Environment, EnvironmentMap};
 pub use point::{PointLight, SpotCone, SpotFalloff};
 
 use crate::sampling::power_heuristic;
-use crate::simd::{F32x8, M32x8, Real, V3};
+use crate::simd::{F32x8, M32x8, Real, V3, set_bits};
 
 use crate::color::Rgb;
 use glam::{Vec2, Vec3};
@@ -122,11 +122,11 @@ impl Lights {
     }
 
     /// [`Lights::sample`] from eight points `p` in lanes, with the numbers `u_select` and the
-    /// pairs `u` (their first numbers, then their second) of each lane. The light, and a mesh
-    /// light's triangle, are chosen lane by lane; the point on the triangle and a constant
-    /// environment's direction are computed in lanes, and the one each lane chose kept. Other
-    /// lights (spheres, points, suns, environment maps) are sampled lane by lane
-    /// ([`Lights::sample`]).
+    /// pairs `u` (their first numbers, then their second) of each lane. The light is chosen lane
+    /// by lane, and a mesh light's triangle for the lanes that chose one; the point on the
+    /// triangle and a constant environment's direction are computed in lanes, and the one each
+    /// lane chose kept. Other lights (spheres, points, suns, environment maps) are sampled lane
+    /// by lane ([`Lights::sample`]).
     #[inline(always)]
     pub fn sample_lanes(&self, p: V3<F32x8>, u_select: [f32; 8], u: [F32x8; 2]) -> LightSampleLanes {
         let [u_x, u_y] = u;
@@ -140,38 +140,55 @@ impl Lights {
         let (mut chosen, mut sky, mut alone) = ([false; 8], [false; 8], [false; 8]);
         let (mut alone_wi, mut alone_point, mut alone_pdf) = (V3::splat(0.0), V3::splat(0.0), [0.0; 8]);
         let (mut alone_valid, mut alone_at_infinity, mut delta) = ([false; 8], [false; 8], [false; 8]);
-        // The environment's index, where there is one: after the areas, points and suns.
+        // The environment's index, where there is one: after the areas, points and suns, and
+        // its radiance where it is constant.
         let sky_index = self.area.len() + self.points.len() + self.distant.len();
+        let constant_sky = match &self.environment {
+            Some(Environment::Constant(c)) => Some(*c),
+            _ => None,
+        };
+        // Each lane's light, and as bits the lanes that chose a mesh light and those sampled
+        // one at a time, without a branch on the lane's choice: one is mispredicted for every
+        // other lane in a scene of one area light and a sky.
+        let (mut choice, mut meshes, mut others) = ([0; 8], 0u32, 0u32);
         for lane in 0..8 {
             let Some(i) = self.choose(u_select[lane]) else { continue };
-            chosen[lane] = true;
-            let mesh = self.area.get(i).and_then(|light| Some((light, light.pick_triangle(u_x.0[lane])?)));
-            if let Some((light, (vertices, n, u_remapped))) = mesh {
-                for (corner, v) in triangle.iter_mut().zip(vertices) {
-                    corner.set_lane(lane, v);
-                }
-                normal.set_lane(lane, n);
-                (u_triangle[lane], area[lane]) = (u_remapped, light.area());
-                radiance.set_lane(lane, light.radiance.into());
-            } else if let (true, Some(Environment::Constant(c))) = (i == sky_index, &self.environment) {
-                sky[lane] = true;
-                radiance.set_lane(lane, (*c).into());
-            } else {
-                alone[lane] = true;
-                let Some(s) = self.sample_chosen(i, p.lane(lane), Vec2::new(u_x.0[lane], u_y.0[lane])) else {
-                    continue;
-                };
-                (alone_valid[lane], alone_pdf[lane]) = (true, s.pdf);
-                alone_wi.set_lane(lane, s.wi);
-                alone_point.set_lane(lane, s.point.unwrap_or(Vec3::ZERO));
-                alone_at_infinity[lane] = s.point.is_none();
-                radiance.set_lane(lane, s.radiance.into());
-                delta[lane] = s.delta;
+            (choice[lane], chosen[lane]) = (i, true);
+            sky[lane] = (i == sky_index) & constant_sky.is_some();
+            meshes |= u32::from(i < self.area.len()) << lane;
+            others |= u32::from((i >= self.area.len()) & !sky[lane]) << lane;
+        }
+        for lane in set_bits(meshes) {
+            let light = &self.area[choice[lane]];
+            let Some((vertices, n, u_remapped)) = light.pick_triangle(u_x.0[lane]) else {
+                // A sphere.
+                others |= 1 << lane;
+                continue;
+            };
+            for (corner, v) in triangle.iter_mut().zip(vertices) {
+                corner.set_lane(lane, v);
             }
+            normal.set_lane(lane, n);
+            (u_triangle[lane], area[lane]) = (u_remapped, light.area());
+            radiance.set_lane(lane, light.radiance.into());
+        }
+        for lane in set_bits(others) {
+            alone[lane] = true;
+            let Some(s) = self.sample_chosen(choice[lane], p.lane(lane), Vec2::new(u_x.0[lane], u_y.0[lane])) else {
+                continue;
+            };
+            (alone_valid[lane], alone_pdf[lane]) = (true, s.pdf);
+            alone_wi.set_lane(lane, s.wi);
+            alone_point.set_lane(lane, s.point.unwrap_or(Vec3::ZERO));
+            alone_at_infinity[lane] = s.point.is_none();
+            radiance.set_lane(lane, s.radiance.into());
+            delta[lane] = s.delta;
         }
         let (q, pdf) = area::triangle_point_of(p, triangle, normal, [F32x8(u_triangle), u_y], F32x8(area));
         let toward = area::toward_light_of(p, q, normal, pdf);
         let (sky, alone) = (M32x8::from_bools(sky), M32x8::from_bools(alone));
+        let sky_radiance = constant_sky.unwrap_or(Rgb::ZERO).to_array().map(F32x8::splat);
+        let radiance = V3::select(sky, V3::new(sky_radiance[0], sky_radiance[1], sky_radiance[2]), radiance);
         let pdf = F32x8::select(sky, F32x8::splat(crate::sampling::warp::UNIFORM_SPHERE_PDF), pdf);
         let wi = V3::select(sky, crate::sampling::warp::square_to_uniform_sphere_of([u_x, u_y]), toward.wi);
         let in_lanes_valid = sky | toward.valid;

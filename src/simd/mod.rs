@@ -297,6 +297,17 @@ impl V3<F32x8> {
     }
 }
 
+/// The indices of the bits set in `mask`, lowest first: the lanes a bit mask selects, or the
+/// children a node's box test lets through.
+#[inline(always)]
+pub fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        let i = (mask != 0).then_some(mask.trailing_zeros() as usize)?;
+        mask &= mask - 1;
+        Some(i)
+    })
+}
+
 /// What the lane tests of the BSDFs share.
 #[cfg(test)]
 pub(crate) mod testing {
