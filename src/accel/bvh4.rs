@@ -848,6 +848,45 @@ mod tests {
     }
 
     #[test]
+    fn rays_through_a_box_corner_enter_it_far_from_the_world_origin() {
+        // A ray that only touches a box, at its corner, decides by its last bits whether it
+        // enters: Ize's enlargement of the far distance must cover the rounding, also where
+        // the box and the origin are far from the world's origin (an error relative to their
+        // coordinates, not to the distance, would not be covered). Coordinates on a 1/64 grid
+        // and integer directions make `corner - d` exact, so each ray passes exactly through
+        // its corner. Directions have no zero component: a ray that lies in a box's face plane
+        // is culled (docs/design-decisions.md, "Two rays' traversals interleaved").
+        let mut rng = crate::accel::tests::Lcg(11);
+        let grid =
+            |rng: &mut crate::accel::tests::Lcg, scale: f32| ((rng.next() * 2.0 - 1.0) * scale * 64.0).round() / 64.0;
+        let mut tested = 0;
+        while tested < 20_000 {
+            let lo = Vec3::new(grid(&mut rng, 1e4), grid(&mut rng, 1e4), grid(&mut rng, 1e4));
+            let size = Vec3::new(grid(&mut rng, 4.0), grid(&mut rng, 4.0), grid(&mut rng, 4.0));
+            let hi = lo + size.abs().max(Vec3::splat(1.0 / 64.0));
+            let d = Vec3::new(grid(&mut rng, 1.5e4), grid(&mut rng, 1.5e4), grid(&mut rng, 1.5e4)).round();
+            if d.cmpeq(Vec3::ZERO).any() {
+                continue;
+            }
+            let bvh = crate::accel::build_bvh4(&[[lo, Vec3::new(hi.x, lo.y, hi.z), Vec3::new(lo.x, hi.y, hi.z)]], &[]);
+            let root = &bvh.nodes[0];
+            let used = root.bounds[0].cmplt(Vec4::INFINITY).bitmask();
+            let pick = (rng.next() * 8.0) as usize;
+            let corner = Vec3::select(glam::BVec3::new(pick & 1 != 0, pick & 2 != 0, pick & 4 != 0), hi, lo);
+            let o = corner - d;
+            assert_eq!(o + d, corner, "the ray must pass exactly through the corner");
+            let ray = Ray::new(o, d);
+            let why = format!("the box [{lo}, {hi}] missed by the ray from {o} along {d} through {corner}");
+            assert_eq!(RayBoxes::new(&ray).test(root, f32::INFINITY).0, used, "{why}");
+            // A packet's node test, and its rays' leaf test.
+            let packet = [CoherentRay::new(&ray), CoherentRay::new(&ray)];
+            assert_eq!(PacketBoxes::new(&packet).test(root, f32::INFINITY).0, used, "packet: {why}");
+            assert!(packet[0].enters(&bvh.leaves[0], f32::INFINITY), "leaf: {why}");
+            tested += 1;
+        }
+    }
+
+    #[test]
     fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
         let tris = crate::accel::tests::lopsided_scene();
         let bvh = crate::accel::build_bvh4(&tris, &[]);
