@@ -25,7 +25,8 @@
 //!
 //! Box tests are conservative as in Ize 2013 ("Robust BVH Ray Traversal", JCGT 2(2)): the far
 //! distance is enlarged by 2 gamma(3), so that rounding never culls a box the ray touches (a
-//! single ray's through a reciprocal enlarged once per ray, as Ize does).
+//! single ray's through a reciprocal enlarged once per ray, as Ize does), and a ray that runs
+//! in the plane of a box's face enters the box (`SlabRay`).
 
 use super::leaf_plane::LeafPlane;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
@@ -89,11 +90,12 @@ pub(super) struct Bvh4 {
     planes: Vec<LeafPlane>,
 }
 
-/// Per-ray constants of the box test.
+/// Per-ray constants of the box test ([`SlabRay`]).
 struct RayBoxes {
     /// Per axis, 1 when the near plane is the max plane (a negative direction), else 0.
     near_is_max: [usize; 3],
     origin: [Vec4; 3],
+    origin_far: [Vec4; 3],
     inv_d: [Vec4; 3],
     /// `inv_d` enlarged by [`ROBUST_FAR`], for the far planes (Ize 2013).
     inv_d_far: [Vec4; 3],
@@ -106,13 +108,34 @@ trait BoxTest {
     fn test(&self, node: &Node, t_max: f32) -> (u32, Vec4);
 }
 
-/// The reciprocal of a direction whose zero components are made tiny ones of the same sign, so
-/// that it stays finite and no 0 * inf makes a NaN in the slab test.
-#[inline(always)]
-fn safe_reciprocal(d: Vec3) -> Vec3A {
-    let d = Vec3A::from(d);
-    let tiny = Vec3A::splat(1e-20);
-    Vec3A::select(d.abs().cmplt(tiny), tiny.copysign(d), d).recip()
+/// A ray's constants for the slab tests of boxes: the reciprocal of its direction, whose zero
+/// components are made tiny ones of the same sign, so that it stays finite and no 0 * inf makes
+/// a NaN; its origin, from which the near planes are measured; and the origin from which the
+/// far planes are. Along an axis where the direction is (made) tiny, the ray stays in the slab
+/// it starts in, on its faces too; but a face through the origin would be at 0 * (1 / tiny) =
+/// 0, a far bound that culls the box. On such an axis the far planes are measured from the
+/// origin moved back (against the direction) by a millionth of its size and at least a
+/// millionth, so that a face through the origin lies at least 1e24 ahead; elsewhere from the
+/// origin itself.
+struct SlabRay {
+    inv_d: Vec3A,
+    o: Vec3A,
+    o_far: Vec3A,
+}
+
+impl SlabRay {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        let (d, o) = (Vec3A::from(ray.d), Vec3A::from(ray.o));
+        let tiny = Vec3A::splat(1e-30);
+        let along_face = d.abs().cmplt(tiny);
+        let shift = (o.abs() + Vec3A::ONE) * 2f32.powi(-20);
+        SlabRay {
+            inv_d: Vec3A::select(along_face, tiny.copysign(d), d).recip(),
+            o,
+            o_far: Vec3A::select(along_face, o - shift.copysign(d), o),
+        }
+    }
 }
 
 /// Each component of `v` in all four lanes, per axis: the per-ray constants of a box test.
@@ -130,10 +153,11 @@ fn near_is_max(inv_d: Vec3A) -> [usize; 3] {
 
 impl RayBoxes {
     fn new(ray: &Ray) -> Self {
-        let inv_d = safe_reciprocal(ray.d);
+        let SlabRay { inv_d, o, o_far } = SlabRay::new(ray);
         RayBoxes {
             near_is_max: near_is_max(inv_d),
-            origin: splat_axes(ray.o.into()),
+            origin: splat_axes(o),
+            origin_far: splat_axes(o_far),
             inv_d: splat_axes(inv_d),
             inv_d_far: splat_axes(inv_d * ROBUST_FAR),
         }
@@ -147,10 +171,10 @@ impl BoxTest for RayBoxes {
         // difference, then the product, by the enlarged reciprocal for the far plane, so that
         // the enlargement bounds the rounding and costs nothing per node. `& 1` keeps the index
         // provably in bounds.
-        let plane = |axis: usize, max_side: usize| node.bounds[2 * axis + (max_side & 1)] - self.origin[axis];
+        let plane = |axis: usize, max_side: usize| node.bounds[2 * axis + (max_side & 1)];
         let [nx, ny, nz] = self.near_is_max;
-        let near = |axis: usize, side: usize| plane(axis, side) * self.inv_d[axis];
-        let far = |axis: usize, side: usize| plane(axis, side ^ 1) * self.inv_d_far[axis];
+        let near = |axis: usize, side: usize| (plane(axis, side) - self.origin[axis]) * self.inv_d[axis];
+        let far = |axis: usize, side: usize| (plane(axis, side ^ 1) - self.origin_far[axis]) * self.inv_d_far[axis];
         let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
         let t_far = far(0, nx).min(far(1, ny)).min(far(2, nz).min(Vec4::splat(t_max)));
         (t_near.cmple(t_far).bitmask(), t_near)
@@ -176,13 +200,15 @@ impl PacketBoxes {
     fn new(rays: &[CoherentRay]) -> Self {
         let (mut inv_lo, mut inv_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         let (mut o_lo, mut o_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        let (mut o_far_lo, mut o_far_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for r in rays {
-            (inv_lo, inv_hi) = (inv_lo.min(r.inv_d), inv_hi.max(r.inv_d));
-            (o_lo, o_hi) = (o_lo.min(r.o), o_hi.max(r.o));
+            (inv_lo, inv_hi) = (inv_lo.min(r.slab.inv_d), inv_hi.max(r.slab.inv_d));
+            (o_lo, o_hi) = (o_lo.min(r.slab.o), o_hi.max(r.slab.o));
+            (o_far_lo, o_far_hi) = (o_far_lo.min(r.slab.o_far), o_far_hi.max(r.slab.o_far));
         }
         // One octant: a negative lower end means every reciprocal on that axis is negative.
         let negative = inv_lo.cmplt(Vec3A::ZERO);
-        let (o_near, o_far) = (Vec3A::select(negative, o_lo, o_hi), Vec3A::select(negative, o_hi, o_lo));
+        let (o_near, o_far) = (Vec3A::select(negative, o_lo, o_hi), Vec3A::select(negative, o_far_hi, o_far_lo));
         PacketBoxes {
             near_is_max: near_is_max(inv_lo),
             inv_lo: splat_axes(inv_lo),
@@ -215,23 +241,21 @@ impl BoxTest for PacketBoxes {
 
 /// One ray of a coherent packet: what its own tests need.
 struct CoherentRay {
-    o: Vec3A,
-    inv_d: Vec3A,
+    slab: SlabRay,
     shear: RayShear,
 }
 
 impl CoherentRay {
     fn new(ray: &Ray) -> Self {
-        CoherentRay { o: ray.o.into(), inv_d: safe_reciprocal(ray.d), shear: RayShear::new(ray) }
+        CoherentRay { slab: SlabRay::new(ray), shear: RayShear::new(ray) }
     }
 
     /// Whether the ray meets `leaf`'s box within (0, t_max) (robust as the node test).
     #[inline(always)]
     fn enters(&self, leaf: &Leaf, t_max: f32) -> bool {
-        let t0 = (leaf.lo - self.o) * self.inv_d;
-        let t1 = (leaf.hi - self.o) * self.inv_d;
-        let t_near = t0.min(t1).max_element().max(0.0);
-        let t_far = t0.max(t1).min_element().min(t_max);
+        let SlabRay { inv_d, o, o_far } = &self.slab;
+        let t_near = ((leaf.lo - o) * inv_d).min((leaf.hi - o) * inv_d).max_element().max(0.0);
+        let t_far = ((leaf.lo - o_far) * inv_d).max((leaf.hi - o_far) * inv_d).min_element().min(t_max);
         t_near <= t_far * ROBUST_FAR
     }
 }
@@ -854,8 +878,7 @@ mod tests {
         // the box and the origin are far from the world's origin (an error relative to their
         // coordinates, not to the distance, would not be covered). Coordinates on a 1/64 grid
         // and integer directions make `corner - d` exact, so each ray passes exactly through
-        // its corner. Directions have no zero component: a ray that lies in a box's face plane
-        // is culled (docs/design-decisions.md, "Two rays' traversals interleaved").
+        // its corner; where a component is zero, the ray lies in the plane of two faces.
         let mut rng = crate::accel::tests::Lcg(11);
         let grid =
             |rng: &mut crate::accel::tests::Lcg, scale: f32| ((rng.next() * 2.0 - 1.0) * scale * 64.0).round() / 64.0;
@@ -864,8 +887,15 @@ mod tests {
             let lo = Vec3::new(grid(&mut rng, 1e4), grid(&mut rng, 1e4), grid(&mut rng, 1e4));
             let size = Vec3::new(grid(&mut rng, 4.0), grid(&mut rng, 4.0), grid(&mut rng, 4.0));
             let hi = lo + size.abs().max(Vec3::splat(1.0 / 64.0));
-            let d = Vec3::new(grid(&mut rng, 1.5e4), grid(&mut rng, 1.5e4), grid(&mut rng, 1.5e4)).round();
-            if d.cmpeq(Vec3::ZERO).any() {
+            let mut d = Vec3::new(grid(&mut rng, 1.5e4), grid(&mut rng, 1.5e4), grid(&mut rng, 1.5e4)).round();
+            // A quarter of the components zero, of either sign: the ray then lies in the plane
+            // of the box's faces on that axis.
+            for axis in 0..3 {
+                if rng.next() < 0.25 {
+                    d[axis] = if rng.next() < 0.5 { 0.0 } else { -0.0 };
+                }
+            }
+            if d.length_squared() == 0.0 {
                 continue;
             }
             let bvh = crate::accel::build_bvh4(&[[lo, Vec3::new(hi.x, lo.y, hi.z), Vec3::new(lo.x, hi.y, hi.z)]], &[]);
