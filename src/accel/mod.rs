@@ -124,7 +124,7 @@ impl Accel {
     }
 
     /// Run `f` with ray queries that share this thread's traversal stacks: a batch of queries
-    /// (a stage of the wavefront) takes it once, rather than once per ray.
+    /// (a stage of the wavefront) takes them once, rather than once per ray.
     #[inline]
     pub fn queries<R>(&self, f: impl FnOnce(&mut Queries<'_>) -> R) -> R {
         TRAVERSAL_STACKS.with(|cell| match cell.try_borrow_mut() {

@@ -161,7 +161,7 @@ impl Lights {
         for lane in set_bits(meshes) {
             let light = &self.area[choice[lane]];
             let Some((vertices, n, u_remapped)) = light.pick_triangle(u_x.0[lane]) else {
-                // A sphere.
+                // A sphere light: sampled alone, below.
                 others |= 1 << lane;
                 continue;
             };
