@@ -648,7 +648,7 @@ impl<A> Query<A> {
 /// loads and tests, which leaves the core idle while one ray waits on its node; the other ray's
 /// steps fill that time. Each query takes the steps it takes alone, so gives the same answer.
 /// (Two queries in named variables: held in an array, indexed in a loop, they ran slower, and
-/// so did four.)
+/// so did four, and three in named variables.)
 #[inline(always)]
 fn interleave<Q>(
     count: usize,
