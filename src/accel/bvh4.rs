@@ -542,7 +542,7 @@ impl Bvh4 {
             &mut walk,
             stack,
             #[inline(always)]
-            |node, t_max| leaf(node, t_max),
+            |visited, t_max| leaf(visited, t_max),
         ) {}
     }
 
