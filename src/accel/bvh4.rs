@@ -6,7 +6,9 @@
 //! each node holds its four children's boxes in structure-of-arrays form, so that one ray is
 //! tested against all four at once, and each leaf holds packets of four triangles tested at once
 //! (`watertight.rs`). Collapsing opens, while a node has fewer than four children, the child of
-//! largest surface area; subtrees of at most four triangles become one packet.
+//! largest surface area; subtrees of at most four triangles become one packet, which is the
+//! leaf: its index sits in the parent's child entry, so that a ray reaches the triangles with
+//! no load between.
 //!
 //! Coherent rays (a pixel's camera rays) can be traced together: one traversal for the packet,
 //! whose box test bounds all its rays by interval arithmetic, with each ray's own box and
@@ -36,8 +38,15 @@ use crate::simd::set_bits;
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
-/// Children of a node that are leaves: `LEAF | index into Bvh4::leaves`.
+/// Children of a node that are leaves: `LEAF | leaf index`, with [`PLANE`] set where the leaf
+/// keeps its plane. A leaf is one packet: its index is that of `Bvh4::packets` and of
+/// `Bvh4::leaves`, so that a ray reaches its triangles without a load on the way.
 const LEAF: u32 = 1 << 31;
+/// Set in a leaf's child entry where the leaf keeps its plane ([`Leaf::plane`]): shadow rays
+/// read the leaf's entry only then.
+const PLANE: u32 = 1 << 30;
+/// The leaf index in a leaf's child entry.
+const LEAF_INDEX: u32 = PLANE - 1;
 /// 1 + 2 gamma(3) with gamma(n) = n eps / (1 - n eps), eps = 2^-24 (Ize 2013).
 const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
@@ -48,30 +57,19 @@ struct Node {
     /// `[min x, max x, min y, max y, min z, max z]`, lane i for child i; an unused slot has the
     /// empty box (min +inf, max -inf), which no ray enters.
     bounds: [Vec4; 6],
-    /// A node index, or `LEAF | leaf index`.
+    /// A node index, or a leaf's entry ([`LEAF`]).
     children: [u32; 4],
 }
 
-/// The triangles of one leaf: `count` packets from `first`, their bounding box (for the
-/// per-ray test of [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray),
-/// and, where they all emit and are flat, their plane (an index into `Bvh4::planes`, else
-/// [`NO_PLANE`]), which shadow rays towards them clear ([`LeafPlane`]).
+/// What a leaf's packet of triangles does not hold: their bounding box (for the per-ray test
+/// of [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray), and, where
+/// they all emit and are flat, their plane (an index into `Bvh4::planes`), which shadow rays
+/// towards them clear ([`LeafPlane`]).
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
-    first: u32,
-    count: u32,
-    plane: u32,
+    plane: Option<u32>,
     lo: Vec3A,
     hi: Vec3A,
-}
-
-/// [`Leaf::plane`] of a leaf without one.
-const NO_PLANE: u32 = u32::MAX;
-
-impl Leaf {
-    fn packets(&self) -> std::ops::Range<usize> {
-        self.first as usize..(self.first + self.count) as usize
-    }
 }
 
 /// Four triangles of a leaf, for its tests, and the index of each lane's triangle (short packets
@@ -82,11 +80,11 @@ struct Packet {
     ids: [u32; 4],
 }
 
-/// The four-wide BVH; node 0 is the root.
+/// The four-wide BVH; node 0 is the root. Leaf i is `packets[i]` and `leaves[i]`.
 pub(super) struct Bvh4 {
     nodes: Vec<Node>,
-    leaves: Vec<Leaf>,
     packets: Vec<Packet>,
+    leaves: Vec<Leaf>,
     planes: Vec<LeafPlane>,
 }
 
@@ -426,31 +424,29 @@ impl Bvh4 {
         );
     }
 
-    /// Shorten `t_max` and `closest` to the closest hit of the ray (`shear`) in `leaf`.
+    /// Shorten `t_max` and `closest` to the closest hit of the ray (`shear`) in the leaf of
+    /// child entry `leaf` ([`LEAF`]).
     #[inline(always)]
-    fn closest_in_leaf(&self, shear: &RayShear, leaf: &Leaf, t_max: &mut f32, closest: &mut Option<Hit>) {
-        for p in leaf.packets() {
-            let packet = &self.packets[p];
-            if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
-                *closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
-                *t_max = t;
-            }
+    fn closest_in_leaf(&self, shear: &RayShear, leaf: u32, t_max: &mut f32, closest: &mut Option<Hit>) {
+        let packet = &self.packets[(leaf & LEAF_INDEX) as usize];
+        if let Some(PacketHit { lane, t, b1, b2 }) = shear.intersect(&packet.triangles, *t_max) {
+            *closest = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
+            *t_max = t;
         }
     }
 
-    /// Whether a triangle of `leaf` lies on `ray` (`shear`) before `t_max`.
+    /// Whether a triangle of the leaf of child entry `leaf` ([`LEAF`]) lies on `ray` (`shear`)
+    /// before `t_max`.
     #[inline(always)]
-    fn blocks_in_leaf(&self, ray: &Ray, shear: &RayShear, leaf: &Leaf, t_max: f32) -> bool {
-        if leaf.plane != NO_PLANE && self.planes[leaf.plane as usize].clears(ray, t_max) {
+    fn blocks_in_leaf(&self, ray: &Ray, shear: &RayShear, leaf: u32, t_max: f32) -> bool {
+        let index = (leaf & LEAF_INDEX) as usize;
+        if leaf & PLANE != 0
+            && let Some(plane) = self.leaves[index].plane
+            && self.planes[plane as usize].clears(ray, t_max)
+        {
             return false;
         }
-        // A loop, not `Iterator::any`, which LLVM leaves out of line (see `Isa::run`).
-        for p in leaf.packets() {
-            if shear.occludes(&self.packets[p].triangles, t_max) {
-                return true;
-            }
-        }
-        false
+        shear.occludes(&self.packets[index].triangles, t_max)
     }
 
     /// The closest hit of each ray of `rays` (at most 32), as [`Bvh4::intersect`] gives it but
@@ -505,16 +501,15 @@ impl Bvh4 {
             stack,
             #[inline(always)]
             |leaf, packet_t_max| {
+                let (bounds, triangles) =
+                    (&self.leaves[(leaf & LEAF_INDEX) as usize], &self.packets[(leaf & LEAF_INDEX) as usize]);
                 for (k, ray) in packet[..n].iter().enumerate() {
-                    if !ray.enters(leaf, t_max[k]) {
+                    if !ray.enters(bounds, t_max[k]) {
                         continue;
                     }
-                    for p in leaf.packets() {
-                        let packet = &self.packets[p];
-                        if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&packet.triangles, t_max[k]) {
-                            hits[index[k]] = Some(Hit { primitive: packet.ids[lane], t, b1, b2 });
-                            t_max[k] = t;
-                        }
+                    if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&triangles.triangles, t_max[k]) {
+                        hits[index[k]] = Some(Hit { primitive: triangles.ids[lane], t, b1, b2 });
+                        t_max[k] = t;
                     }
                 }
                 *packet_t_max = farthest(&t_max[..n]);
@@ -523,9 +518,9 @@ impl Bvh4 {
         );
     }
 
-    /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(leaf, t_max)`, which may
-    /// shorten `t_max` to a hit and returns true to end the traversal. With `CLOSEST`, children
-    /// are visited nearest first and boxes beyond `t_max` are skipped; without, in any order (a
+    /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(its entry, t_max)`
+    /// ([`LEAF`]), which may shorten `t_max` to a hit and returns true to end the traversal.
+    /// With `CLOSEST`, children are visited nearest first and boxes beyond `t_max` are skipped; without, in any order (a
     /// shadow ray needs any hit, not the nearest). `stack` holds the children still to visit.
     #[inline(always)]
     fn traverse<const CLOSEST: bool>(
@@ -533,7 +528,7 @@ impl Bvh4 {
         boxes: &impl BoxTest,
         t_max: f32,
         stack: &mut TraversalStack,
-        mut leaf: impl FnMut(&Leaf, &mut f32) -> bool,
+        mut leaf: impl FnMut(u32, &mut f32) -> bool,
     ) {
         stack.clear();
         let mut walk = Walk::new(t_max);
@@ -554,7 +549,7 @@ impl Bvh4 {
         boxes: &impl BoxTest,
         walk: &mut Walk,
         stack: &mut TraversalStack,
-        leaf: impl FnOnce(&Leaf, &mut f32) -> bool,
+        leaf: impl FnOnce(u32, &mut f32) -> bool,
     ) -> bool {
         let current = walk.current;
         if current & LEAF == 0 {
@@ -607,7 +602,7 @@ impl Bvh4 {
                 walk.current = hits[n - 1].0;
                 return true;
             }
-        } else if leaf(&self.leaves[(current & !LEAF) as usize], &mut walk.t_max) {
+        } else if leaf(current, &mut walk.t_max) {
             return false;
         }
         // Next: the nearest entry on the stack that is not beyond the closest hit.
@@ -740,6 +735,19 @@ fn subtree_sizes(bvh2: &Bvh2) -> Vec<u32> {
     sizes
 }
 
+/// A node's `bounds` over the children's boxes `(min, max)` (at most four): plane 2 axis + 0 / 1
+/// is the min / max along the axis; unused lanes get the empty box.
+fn node_bounds(boxes: &[(Vec3A, Vec3A)]) -> [Vec4; 6] {
+    std::array::from_fn(|plane| {
+        Vec4::from_array(std::array::from_fn(|lane| match boxes.get(lane) {
+            Some(&(lo, _)) if plane % 2 == 0 => lo[plane / 2],
+            Some(&(_, hi)) => hi[plane / 2],
+            None if plane % 2 == 0 => f32::INFINITY,
+            None => f32::NEG_INFINITY,
+        }))
+    })
+}
+
 struct Builder<'a> {
     bvh2: &'a Bvh2,
     triangles: &'a [[Vec3; 3]],
@@ -772,16 +780,8 @@ impl Builder<'_> {
         }
 
         let index = self.out.nodes.len();
-        // Plane 2 axis + 0 / 1: min / max along the axis; unused lanes get the empty box.
-        let bounds = std::array::from_fn(|plane| {
-            Vec4::from_array(std::array::from_fn(|lane| match children.get(lane) {
-                Some(&c) if plane % 2 == 0 => nodes[c].aabb().min[plane / 2],
-                Some(&c) => nodes[c].aabb().max[plane / 2],
-                None if plane % 2 == 0 => f32::INFINITY,
-                None => f32::NEG_INFINITY,
-            }))
-        });
-        self.out.nodes.push(Node { bounds, children: [LEAF; 4] });
+        let boxes: Vec<_> = children.iter().map(|&c| (nodes[c].aabb().min, nodes[c].aabb().max)).collect();
+        self.out.nodes.push(Node { bounds: node_bounds(&boxes), children: [LEAF; 4] });
         // Reversed, so that the first child is emitted next, beside its parent.
         for (lane, &c) in children.iter().enumerate().rev() {
             if opens(c, &self.sizes) {
@@ -793,7 +793,8 @@ impl Builder<'_> {
         index as u32
     }
 
-    /// Emit all triangles under binary node `n2` as one leaf; `LEAF | its index`.
+    /// Emit the triangles under binary node `n2` as leaves: one, where they are at most four
+    /// (as subtrees that are not opened are); else nodes over leaves of four. Its child entry.
     fn leaf(&mut self, n2: usize) -> u32 {
         let nodes = &self.bvh2.nodes;
         let mut ids = Vec::new();
@@ -807,29 +808,45 @@ impl Builder<'_> {
                 pending.extend([node.first_index as usize + 1, node.first_index as usize]);
             }
         }
-        let out = &mut self.out;
-        let first = out.packets.len() as u32;
+        self.leaves_over(&ids).0
+    }
+
+    /// Leaves over the triangles `ids` (not empty): one packet where they are at most four,
+    /// else a node over up to four groups of them, each a multiple of four but the last. Its
+    /// child entry and the triangles' bounding box.
+    fn leaves_over(&mut self, ids: &[u32]) -> (u32, Vec3A, Vec3A) {
+        if ids.len() > 4 {
+            let group = ids.len().div_ceil(4).next_multiple_of(4);
+            let children: Vec<_> = ids.chunks(group).map(|chunk| self.leaves_over(chunk)).collect();
+            let boxes: Vec<_> = children.iter().map(|&(_, lo, hi)| (lo, hi)).collect();
+            let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+            for &(clo, chi) in &boxes {
+                (lo, hi) = (lo.min(clo), hi.max(chi));
+            }
+            let entries = std::array::from_fn(|lane| children.get(lane).map_or(LEAF, |c| c.0));
+            self.out.nodes.push(Node { bounds: node_bounds(&boxes), children: entries });
+            return (self.out.nodes.len() as u32 - 1, lo, hi);
+        }
+        let tris: Vec<[Vec3; 3]> = ids.iter().map(|&i| self.triangles[i as usize]).collect();
         let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-        for v in ids.iter().flat_map(|&i| self.triangles[i as usize]) {
+        for &v in tris.iter().flatten() {
             (lo, hi) = (lo.min(v.into()), hi.max(v.into()));
         }
-        for chunk in ids.chunks(4) {
-            let tris: Vec<[Vec3; 3]> = chunk.iter().map(|&i| self.triangles[i as usize]).collect();
-            let ids = std::array::from_fn(|lane| *chunk.get(lane).unwrap_or(&chunk[0]));
-            out.packets.push(Packet { triangles: TrianglePacket::new(&tris), ids });
-        }
+        let out = &mut self.out;
+        out.packets.push(Packet {
+            triangles: TrianglePacket::new(&tris),
+            ids: std::array::from_fn(|lane| *ids.get(lane).unwrap_or(&ids[0])),
+        });
         // Only leaves whose triangles all emit keep their plane (`leaf_plane.rs` says why).
         let emits = !self.emitting.is_empty() && ids.iter().all(|&i| self.emitting[i as usize]);
-        let triangles = || ids.iter().map(|&i| self.triangles[i as usize]).collect::<Vec<_>>();
-        let plane = match emits.then(|| LeafPlane::of(&triangles())).flatten() {
-            Some(plane) => {
-                out.planes.push(plane);
-                out.planes.len() as u32 - 1
-            }
-            None => NO_PLANE,
-        };
-        out.leaves.push(Leaf { first, count: out.packets.len() as u32 - first, plane, lo, hi });
-        LEAF | (out.leaves.len() as u32 - 1)
+        let plane = emits.then(|| LeafPlane::of(&tris)).flatten().map(|plane| {
+            out.planes.push(plane);
+            out.planes.len() as u32 - 1
+        });
+        out.leaves.push(Leaf { plane, lo, hi });
+        let index = out.leaves.len() as u32 - 1;
+        debug_assert!(index <= LEAF_INDEX, "more leaves than MAX_TRIANGLES allows");
+        (LEAF | if plane.is_some() { PLANE } else { 0 } | index, lo, hi)
     }
 }
 
@@ -916,27 +933,23 @@ mod tests {
         }
     }
 
-    #[test]
-    fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
-        let tris = crate::accel::tests::lopsided_scene();
-        let bvh = crate::accel::build_bvh4(&tris, &[]);
-
-        // Walk the tree: every triangle is reached exactly once, inside every box above it.
+    /// Walk `bvh`: every triangle of `tris` is reached exactly once, inside every box above it,
+    /// and a leaf's plane bit says whether it keeps a plane.
+    fn assert_every_triangle_once_inside_its_boxes(bvh: &Bvh4, tris: &[[Vec3; 3]]) {
         let mut seen = vec![0u32; tris.len()];
         let mut pending = vec![(0u32, Vec3::NEG_INFINITY, Vec3::INFINITY)];
         while let Some((child, lo, hi)) = pending.pop() {
             if child & LEAF != 0 {
-                let leaf = bvh.leaves[(child & !LEAF) as usize];
-                for p in leaf.first..leaf.first + leaf.count {
-                    // Short packets repeat their first triangle.
-                    let mut lanes = bvh.packets[p as usize].ids.to_vec();
-                    lanes.sort();
-                    lanes.dedup();
-                    for t in lanes {
-                        seen[t as usize] += 1;
-                        assert!(tris[t as usize].iter().all(|v| v.cmpge(lo).all() && v.cmple(hi).all()));
-                    }
+                let index = (child & LEAF_INDEX) as usize;
+                // Short packets repeat their first triangle.
+                let mut lanes = bvh.packets[index].ids.to_vec();
+                lanes.sort();
+                lanes.dedup();
+                for t in lanes {
+                    seen[t as usize] += 1;
+                    assert!(tris[t as usize].iter().all(|v| v.cmpge(lo).all() && v.cmple(hi).all()));
                 }
+                assert_eq!(child & PLANE != 0, bvh.leaves[index].plane.is_some(), "the plane bit of leaf {index}");
                 continue;
             }
             let node = &bvh.nodes[child as usize];
@@ -952,5 +965,43 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n == 1), "triangles seen other than once");
+    }
+
+    #[test]
+    fn collapsed_bvh_keeps_every_triangle_once_inside_its_boxes() {
+        let tris = crate::accel::tests::lopsided_scene();
+        assert_every_triangle_once_inside_its_boxes(&crate::accel::build_bvh4(&tris, &[]), &tris);
+    }
+
+    #[test]
+    fn a_binary_leaf_of_many_triangles_becomes_nodes_over_leaves_of_one_packet() {
+        // obvhs keeps its leaves to four triangles; one of 37 (all the binary BVH holds) must
+        // still give leaves of one packet each, under nodes, with the same answers.
+        let tris: Vec<[Vec3; 3]> = crate::accel::tests::lopsided_scene().into_iter().take(37).collect();
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        for &v in tris.iter().flatten() {
+            (lo, hi) = (lo.min(v.into()), hi.max(v.into()));
+        }
+        let bvh2 = Bvh2 {
+            nodes: vec![obvhs::bvh2::node::Bvh2Node::new(obvhs::aabb::Aabb::new(lo, hi), 37, 0)],
+            primitive_indices: (0..37).collect(),
+            ..Default::default()
+        };
+        let bvh = Bvh4::from_bvh2(&bvh2, &tris, &[]);
+        assert!(bvh.nodes.len() > 1, "the leaf was not split");
+        assert_every_triangle_once_inside_its_boxes(&bvh, &tris);
+        let mut stack = TraversalStack::default();
+        for (i, t) in tris.iter().enumerate() {
+            // Straight down onto the middle of triangle i (the lopsided scene's triangles stand
+            // in planes x = const, so along -x from beyond them all).
+            let target = (t[0] + t[1] + t[2]) / 3.0;
+            let ray = Ray::new(Vec3::new(hi.x + 1.0, target.y, target.z), Vec3::NEG_X);
+            let brute = tris.iter().enumerate().filter_map(|(j, tri)| {
+                let shear = RayShear::new(&ray);
+                shear.intersect(&TrianglePacket::new(&[*tri]), f32::INFINITY).map(|h| (h.t, j))
+            });
+            let nearest = brute.min_by(|a, b| a.0.total_cmp(&b.0)).map(|(_, j)| j as u32);
+            assert_eq!(bvh.intersect(&ray, &mut stack).map(|h| h.primitive), nearest, "ray onto triangle {i}");
+        }
     }
 }
