@@ -250,8 +250,13 @@ impl<'a> PathTracer<'a> {
             *radiance += *throughput * lights.arriving_from_infinity(ray.d.normalize(), bsdf_pdf);
             return false;
         };
+        let shape = scene.shape_of(hit.primitive);
+        let last = *depth + 1 >= self.max_depth;
+        if last && shape.light.is_none() {
+            // Nothing to add here and nothing to sample: no hit point needed.
+            return false;
+        }
         let mut si = scene.interaction(ray, &hit);
-        let shape = scene.shape_of(si.primitive);
 
         if let Some(light) = shape.light {
             let emitted = lights.area[light as usize].emitted(si.ng, si.wo);
@@ -264,7 +269,7 @@ impl<'a> PathTracer<'a> {
                 *radiance += *throughput * emitted * w;
             }
         }
-        if *depth + 1 >= self.max_depth {
+        if last {
             return false;
         }
 
