@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """tessera against Mitsuba 3 in one session: samples per second, alternating, medians, ratios.
 
-    python3 reference/bench.py [--rounds 3] [--threads 2] [--scenes A,D]
+    python3 reference/bench.py [--rounds 3] [--threads 2] [--scenes A,D] [--depths 1,2,3]
 
 Scenes: A is scenes/brushed_metal.toml (the render benchmark of `tessera bench`); D is
 scenes/bench_deformed.toml (deformed tiling and blending with Mix-Max, an F map and cut bands,
@@ -10,6 +10,10 @@ evaluated procedurally by tessera; Mitsuba renders `tessera export-mitsuba`'s ba
 Each round renders each scene once with tessera, once with Mitsuba's llvm_ad_rgb and once with
 its scalar_rgb, one after the other, so that a machine that slows down or speeds up during the
 session affects all three alike; the medians over the rounds are printed with their ratios.
+With --depths, each round also renders each scene with those path lengths (max_depth: 1 is the
+camera rays and the emitters they see, 2 adds the first vertex's light sample and bounce), and
+the medians are printed as nanoseconds a sample and what each longer path adds: where along the
+path the time goes, for tessera and for Mitsuba's llvm_ad_rgb.
 Rendering time only, for both: tessera's own figure (`tessera render` prints the samples per
 second of its rendering, after loading), and Mitsuba's `mi.render` timed around (after loading,
 and after one warm-up render that compiles the LLVM kernels). Mitsuba comes from the virtual
@@ -31,10 +35,12 @@ SCENES = {"A": "scenes/brushed_metal.toml", "D": "scenes/bench_deformed.toml"}
 VARIANTS = ("llvm_ad_rgb", "scalar_rgb")
 
 
-def tessera_rate(tessera, scene, threads, out):
-    """tessera's samples per second (millions) rendering `scene`, as it reports them."""
+def tessera_rate(tessera, scene, threads, out, depth=None):
+    """tessera's samples per second (millions) rendering `scene` (paths of at most `depth`
+    segments where given), as it reports them."""
+    depth_args = [] if depth is None else ["--set", f"render.max_depth={depth}"]
     run = subprocess.run(
-        [tessera, "render", scene, "--threads", str(threads), "-o", out],
+        [tessera, "render", scene, "--threads", str(threads), "-o", out, *depth_args],
         cwd=ROOT, capture_output=True, text=True, check=True,
     )
     found = re.search(r"\(([0-9.]+) M samples/s\)", run.stdout + run.stderr)
@@ -51,6 +57,17 @@ def mitsuba_rate(python, xml, variant, threads):
         cwd=ROOT, capture_output=True, text=True, check=True,
     )
     return float(run.stdout.split()[1])
+
+
+def depth_xml(xml, depth):
+    """A copy of the exported scene `xml` whose integrator's max_depth is `depth`."""
+    text = xml.read_text()
+    pattern = r'(<integer name="max_depth" value=")[0-9]+(")'
+    if not re.search(pattern, text):
+        sys.exit(f"bench.py: no max_depth in {xml}")
+    copy = xml.with_name(f"scene_depth{depth}.xml")
+    copy.write_text(re.sub(pattern, rf"\g<1>{depth}\g<2>", text))
+    return copy
 
 
 def machine():
@@ -77,9 +94,16 @@ def main():
     parser.add_argument("--rounds", type=int, default=3, help="alternating rounds (the median is printed)")
     parser.add_argument("--threads", type=int, default=2, help="threads of every renderer")
     parser.add_argument("--scenes", default="A,D", help="which scenes, comma separated: A, D")
+    parser.add_argument("--depths", default="", help="path lengths (max_depth) to time as well, comma separated")
     args = parser.parse_args()
     if args.rounds < 1:
         sys.exit("bench.py: --rounds must be at least 1")
+    try:
+        depths = [int(d) for d in args.depths.split(",") if d.strip()]
+    except ValueError:
+        sys.exit(f"bench.py: --depths takes whole numbers, comma separated, not {args.depths!r}")
+    if any(d < 1 or d > 1000 for d in depths):
+        sys.exit("bench.py: each of --depths must be 1 to 1000")
     names = args.scenes.split(",")
     for name in names:
         if name not in SCENES:
@@ -103,6 +127,7 @@ def main():
             subprocess.run([tessera, "export-mitsuba", scene, "-o", str(out / name)], cwd=ROOT, check=True,
                            capture_output=True)
         rates = {"tessera": []} | ({v: [] for v in VARIANTS} if have_mitsuba else {})
+        by_depth = {k: {d: [] for d in depths} for k in ["tessera"] + (["llvm_ad_rgb"] if have_mitsuba else [])}
         for round_ in range(args.rounds):
             rates["tessera"].append(tessera_rate(tessera, scene, args.threads, str(out / f"{name}.exr")))
             if have_mitsuba:
@@ -110,11 +135,27 @@ def main():
                     rates[variant].append(mitsuba_rate(str(python), str(xml), variant, args.threads))
             print(f"scene {name} round {round_ + 1}: " + ", ".join(f"{k} {v[-1]:.3f}" for k, v in rates.items()),
                   flush=True)
+            for depth in depths:
+                by_depth["tessera"][depth].append(
+                    tessera_rate(tessera, scene, args.threads, str(out / f"{name}.exr"), depth))
+                if have_mitsuba:
+                    by_depth["llvm_ad_rgb"][depth].append(
+                        mitsuba_rate(str(python), str(depth_xml(xml, depth)), "llvm_ad_rgb", args.threads))
         median = {k: statistics.median(v) for k, v in rates.items()}
         print(f"scene {name} ({scene}), {args.threads} threads, medians of {args.rounds} rounds:")
         for k, v in median.items():
             ratio = "" if k == "tessera" else f"   tessera / {k} = {median['tessera'] / v:.2f}x"
             print(f"  {k:<12} {v:7.3f} M samples/s{ratio}")
+        if depths:
+            print(f"scene {name} by path length: ns a sample ({args.threads} threads; + what the longer paths add)")
+            for renderer, rates_of in by_depth.items():
+                ns = {d: 1e3 / statistics.median(r) for d, r in rates_of.items()}
+                ns["full"] = 1e3 / median[renderer]
+                previous, cells = 0.0, []
+                for d, t in ns.items():
+                    cells.append(f"{d}: {t:6.1f} (+{t - previous:5.1f})")
+                    previous = t
+                print(f"  {renderer:<12} " + "  ".join(cells))
 
 
 if __name__ == "__main__":
