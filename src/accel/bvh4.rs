@@ -520,8 +520,9 @@ impl Bvh4 {
 
     /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(its entry, t_max)`
     /// ([`LEAF`]), which may shorten `t_max` to a hit and returns true to end the traversal.
-    /// With `CLOSEST`, children are visited nearest first and boxes beyond `t_max` are skipped; without, in any order (a
-    /// shadow ray needs any hit, not the nearest). `stack` holds the children still to visit.
+    /// With `CLOSEST`, children are visited nearest first and boxes beyond `t_max` are skipped;
+    /// without, in any order (a shadow ray needs any hit, not the nearest). `stack` holds the
+    /// children still to visit.
     #[inline(always)]
     fn traverse<const CLOSEST: bool>(
         &self,
