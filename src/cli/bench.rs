@@ -3,7 +3,10 @@
 //!
 //! - Ray casting on a procedural mesh of 261k triangles (a UV sphere 512 x 256 with folds):
 //!   closest-hit Mrays/s for coherent primary rays (a 1024 x 1024 pinhole view) and for incoherent
-//!   rays (cosine-distributed bounces from the primary hits), on one thread and on all.
+//!   rays (cosine-distributed bounces from the primary hits), on one thread and on all. And scene
+//!   A's first bounces from its ground ([`ground_bounces`]), traced as the wavefront's batches
+//!   are, closest hits and occlusion, on all threads: `reference/time_mitsuba_rays.py` times
+//!   Mitsuba 3 (Embree) on rays drawn alike.
 //! - A full render of `scenes/brushed_metal.toml` (Mitsuba scene A: 512 x 512, 64 spp, max
 //!   depth 8): samples per second, against Mitsuba 3's figures measured on this kind of machine.
 //! - Shading arithmetic in SIMD lanes (issue 19): scene A's aluminium at 1M directions, GGX
@@ -37,7 +40,7 @@ use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
-use tessera::accel::{Accel, AccelKind};
+use tessera::accel::{Accel, AccelKind, Queries};
 use tessera::bsdf::fresnel::fresnel_conductor_of;
 use tessera::bsdf::{Conductor, ConductorFresnel, Diffuse, Ggx};
 use tessera::camera::{Camera, CameraModel, FovAxis};
@@ -117,6 +120,7 @@ pub fn run(scene_dir: &Path, runs: usize, threads: usize, suites: &[Suite]) -> R
     println!("tessera bench: medians of {runs} runs, {threads} threads where parallel");
     if suites.contains(&Suite::Rays) {
         rays(runs, &pool)?;
+        scene_a_bounces(scene_dir, runs, &pool)?;
     }
     if suites.contains(&Suite::Render) {
         render_scene_a(scene_dir, runs, &pool)?;
@@ -222,6 +226,69 @@ fn rays(runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// Rays of scene A's first bounces from its ground, as `reference/time_mitsuba_rays.py` draws
+/// them for Mitsuba: `count` origins uniform over x, z in [-3, 3], 1e-4 above the ground
+/// (y = -1), in cosine-distributed directions about +y. Most leave the scene at once.
+fn ground_bounces(count: usize) -> Vec<Ray> {
+    (0..count)
+        .map(|i| {
+            let mut sampler = Sampler::new(5, i as u64, 0);
+            let at = sampler.next_2d() * 6.0 - 3.0;
+            let d = warp::square_to_cosine_hemisphere(sampler.next_2d());
+            Ray::new(Vec3::new(at.x, -1.0 + 1e-4, at.y), Vec3::new(d.x, d.z, d.y))
+        })
+        .collect()
+}
+
+/// Scene A's first bounces from the ground ([`ground_bounces`], 2^21 rays) traced in batches of
+/// 1,024, as the wavefront hands them to `Queries::intersect_each` and `occluded_each`, on all
+/// threads: Mrays/s for each backend.
+fn scene_a_bounces(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
+    let scene = load_scene(&scene_dir.join("brushed_metal.toml"), &SceneOverrides::default())?;
+    let triangles = scene.geometry.all_triangle_positions();
+    let rays = ground_bounces(1 << 21);
+    for &kind in AccelKind::ALL {
+        let accel = Accel::build_kind(&triangles, &scene.geometry.emitting_triangles(), &scene.geometry.spheres, kind);
+        let closest = |rays: &[Ray]| {
+            in_batches(pool, &accel, rays, None, |q, batch, hits| q.intersect_each(batch, hits), Option::is_some)
+        };
+        let blocked = |rays: &[Ray]| {
+            in_batches(pool, &accel, rays, false, |q, batch, blocked| q.occluded_each(batch, blocked), |&b| b)
+        };
+        let (closest, hits) = rays_per_second(runs, &rays, closest);
+        let (occluded, _) = rays_per_second(runs, &rays, blocked);
+        println!(
+            "rays       {kind:?} scene A ground bounces {} rays ({:.0}% hit): closest {closest:6.2} Mrays/s, occluded {occluded:6.2}, {} threads",
+            rays.len(),
+            100.0 * hits as f64 / rays.len() as f64,
+            pool.current_num_threads()
+        );
+    }
+    Ok(())
+}
+
+/// `query` over `rays` in batches of 1,024 on `pool`, as the wavefront hands its rays over
+/// (each answer starting as `empty`); how many answers `counted` picks.
+fn in_batches<A: Copy + Send + Sync>(
+    pool: &rayon::ThreadPool,
+    accel: &Accel,
+    rays: &[Ray],
+    empty: A,
+    query: impl Fn(&mut Queries, &[Ray], &mut [A]) + Sync,
+    counted: impl Fn(&A) -> bool + Sync,
+) -> usize {
+    pool.install(|| {
+        rays.par_chunks(1024)
+            .map_init(Vec::new, |answers, batch| {
+                answers.clear();
+                answers.resize(batch.len(), empty);
+                accel.queries(|q| query(q, batch, answers));
+                answers.iter().filter(|a| counted(a)).count()
+            })
+            .sum()
+    })
 }
 
 fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Result<()> {
