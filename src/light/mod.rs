@@ -187,8 +187,8 @@ impl Lights {
         let (q, pdf) = area::triangle_point_of(p, triangle, normal, [F32x8(u_triangle), u_y], F32x8(area));
         let toward = area::toward_light_of(p, q, normal, pdf);
         let (sky, alone) = (M32x8::from_bools(sky), M32x8::from_bools(alone));
-        let sky_radiance = constant_sky.unwrap_or(Rgb::ZERO).to_array().map(F32x8::splat);
-        let radiance = V3::select(sky, V3::new(sky_radiance[0], sky_radiance[1], sky_radiance[2]), radiance);
+        let sky_radiance = V3::from([Vec3::from(constant_sky.unwrap_or(Rgb::ZERO)); 8]);
+        let radiance = V3::select(sky, sky_radiance, radiance);
         let pdf = F32x8::select(sky, F32x8::splat(crate::sampling::warp::UNIFORM_SPHERE_PDF), pdf);
         let wi = V3::select(sky, crate::sampling::warp::square_to_uniform_sphere_of([u_x, u_y]), toward.wi);
         let in_lanes_valid = sky | toward.valid;
