@@ -11,12 +11,11 @@
 //! no load between.
 //!
 //! Coherent rays (a pixel's camera rays) can be traced together: one traversal for the packet,
-//! whose box test bounds all its rays by interval arithmetic, with each ray's own box and
-//! triangle tests at the leaves (`intersect_many`).
+//! whose box test bounds all its rays by interval arithmetic, with the rays' own box and
+//! triangle tests at the leaves, eight rays at a time in SIMD lanes (`intersect_many`).
 //!
-//! Incoherent rays (the wavefront's bounce and shadow rays) are traced two at a time, their
-//! traversals advanced step by step in turn (`interleave`), so that one ray's box tests fill the
-//! time the other waits on its node.
+//! The wavefront's bounce and shadow rays are sorted by direction and traced eight at a time,
+//! one per lane, through every node's boxes and every leaf's triangles (`packets.rs`).
 //!
 //! Leaves whose triangles all emit and lie in one plane (a quad light) keep that plane, and shadow
 //! rays that stay clear of it skip their triangle tests (`leaf_plane.rs`).
@@ -30,11 +29,15 @@
 //! single ray's through a reciprocal enlarged once per ray, as Ize does), and a ray that runs
 //! in the plane of a box's face enters the box (`SlabRay`).
 
+mod packets;
+
+pub(super) use packets::{Batch, Closest, Occluded};
+
 use super::leaf_plane::LeafPlane;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
 use super::{Hit, TraversalStack};
 use crate::geometry::Ray;
-use crate::simd::set_bits;
+use crate::simd::{Lanes8, set_bits};
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
@@ -61,15 +64,15 @@ struct Node {
     children: [u32; 4],
 }
 
-/// What a leaf's packet of triangles does not hold: their bounding box (for the per-ray test
-/// of [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray), and, where
+/// What a leaf's packet of triangles does not hold: their bounding box (for the rays' own test
+/// in [`Bvh4::intersect_coherent`], whose traversal bounds the packet, not the ray), and, where
 /// they all emit and are flat, their plane (an index into `Bvh4::planes`), which shadow rays
 /// towards them clear ([`LeafPlane`]).
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     plane: Option<u32>,
-    lo: Vec3A,
-    hi: Vec3A,
+    /// `[min x, max x, min y, max y, min z, max z]`, as a node's boxes.
+    bounds: [f32; 6],
 }
 
 /// Four triangles of a leaf, for its tests, and the index of each lane's triangle (short packets
@@ -78,6 +81,15 @@ struct Leaf {
 struct Packet {
     triangles: TrianglePacket,
     ids: [u32; 4],
+}
+
+impl Packet {
+    /// How many triangles the packet holds (short packets repeat their first).
+    #[inline(always)]
+    fn len(&self) -> usize {
+        let ids = self.ids;
+        1 + (ids[1] != ids[0]) as usize + (ids[2] != ids[0]) as usize + (ids[3] != ids[0]) as usize
+    }
 }
 
 /// The four-wide BVH; node 0 is the root. Leaf i is `packets[i]` and `leaves[i]`.
@@ -115,6 +127,7 @@ trait BoxTest {
 /// origin moved back (against the direction) by a millionth of its size and at least a
 /// millionth, so that a face through the origin lies at least 1e24 ahead; elsewhere from the
 /// origin itself.
+#[derive(Clone, Copy)]
 struct SlabRay {
     inv_d: Vec3A,
     o: Vec3A,
@@ -195,14 +208,14 @@ struct PacketBoxes {
 
 impl PacketBoxes {
     /// The bounds of `rays`, whose directions lie in one octant.
-    fn new(rays: &[CoherentRay]) -> Self {
+    fn new(rays: &[SlabRay]) -> Self {
         let (mut inv_lo, mut inv_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         let (mut o_lo, mut o_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         let (mut o_far_lo, mut o_far_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for r in rays {
-            (inv_lo, inv_hi) = (inv_lo.min(r.slab.inv_d), inv_hi.max(r.slab.inv_d));
-            (o_lo, o_hi) = (o_lo.min(r.slab.o), o_hi.max(r.slab.o));
-            (o_far_lo, o_far_hi) = (o_far_lo.min(r.slab.o_far), o_far_hi.max(r.slab.o_far));
+            (inv_lo, inv_hi) = (inv_lo.min(r.inv_d), inv_hi.max(r.inv_d));
+            (o_lo, o_hi) = (o_lo.min(r.o), o_hi.max(r.o));
+            (o_far_lo, o_far_hi) = (o_far_lo.min(r.o_far), o_far_hi.max(r.o_far));
         }
         // One octant: a negative lower end means every reciprocal on that axis is negative.
         let negative = inv_lo.cmplt(Vec3A::ZERO);
@@ -234,27 +247,6 @@ impl BoxTest for PacketBoxes {
         let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
         let t_far = far(0, nx ^ 1).min(far(1, ny ^ 1)).min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
         (t_near.cmple(t_far * ROBUST_FAR).bitmask(), t_near)
-    }
-}
-
-/// One ray of a coherent packet: what its own tests need.
-struct CoherentRay {
-    slab: SlabRay,
-    shear: RayShear,
-}
-
-impl CoherentRay {
-    fn new(ray: &Ray) -> Self {
-        CoherentRay { slab: SlabRay::new(ray), shear: RayShear::new(ray) }
-    }
-
-    /// Whether the ray meets `leaf`'s box within (0, t_max) (robust as the node test).
-    #[inline(always)]
-    fn enters(&self, leaf: &Leaf, t_max: f32) -> bool {
-        let SlabRay { inv_d, o, o_far } = &self.slab;
-        let t_near = ((leaf.lo - o) * inv_d).min((leaf.hi - o) * inv_d).max_element().max(0.0);
-        let t_far = ((leaf.lo - o_far) * inv_d).max((leaf.hi - o_far) * inv_d).min_element().min(t_max);
-        t_near <= t_far * ROBUST_FAR
     }
 }
 
@@ -370,60 +362,6 @@ impl Bvh4 {
         blocked
     }
 
-    /// The closest hit of each of `rays` into `hits`, as [`Bvh4::intersect`] gives it, two rays'
-    /// traversals interleaved ([`interleave`]).
-    #[inline(always)]
-    pub(super) fn intersect_each(&self, rays: &[Ray], hits: &mut [Option<Hit>], stacks: &mut [TraversalStack; 2]) {
-        interleave(
-            rays.len(),
-            stacks,
-            #[inline(always)]
-            |i| Query::new(rays, i, None),
-            #[inline(always)]
-            |q, stack| {
-                self.step::<true>(
-                    &q.boxes,
-                    &mut q.walk,
-                    stack,
-                    #[inline(always)]
-                    |leaf, t_max| {
-                        self.closest_in_leaf(&q.shear, leaf, t_max, &mut q.answer);
-                        false
-                    },
-                )
-            },
-            #[inline(always)]
-            |q| hits[q.ray] = q.answer,
-        );
-    }
-
-    /// Whether each of `rays` is blocked, into `blocked`, as [`Bvh4::occluded`] answers, two
-    /// rays' traversals interleaved ([`interleave`]).
-    #[inline(always)]
-    pub(super) fn occluded_each(&self, rays: &[Ray], blocked: &mut [bool], stacks: &mut [TraversalStack; 2]) {
-        interleave(
-            rays.len(),
-            stacks,
-            #[inline(always)]
-            |i| Query::new(rays, i, false),
-            #[inline(always)]
-            |q, stack| {
-                self.step::<false>(
-                    &q.boxes,
-                    &mut q.walk,
-                    stack,
-                    #[inline(always)]
-                    |leaf, t_max| {
-                        q.answer = self.blocks_in_leaf(&rays[q.ray], &q.shear, leaf, *t_max);
-                        q.answer
-                    },
-                )
-            },
-            #[inline(always)]
-            |q| blocked[q.ray] = q.answer,
-        );
-    }
-
     /// Shorten `t_max` and `closest` to the closest hit of the ray (`shear`) in the leaf of
     /// child entry `leaf` ([`LEAF`]).
     #[inline(always)]
@@ -450,72 +388,29 @@ impl Bvh4 {
     }
 
     /// The closest hit of each ray of `rays` (at most 32), as [`Bvh4::intersect`] gives it but
-    /// for ties in distance; coherent rays are traced as packets.
+    /// for ties in distance; coherent rays are traced as packets, their leaves' triangles
+    /// tested against eight rays at a time in the lanes of `l`.
     #[inline(always)]
-    pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>], stack: &mut TraversalStack) {
-        for group in coherent_groups(rays) {
-            if group.count_ones() == 1 {
-                let i = group.trailing_zeros() as usize;
-                hits[i] = self.intersect(&rays[i], stack);
-            } else if group.count_ones() <= 8 {
-                // Packets in arrays of their size: each slot's ray is set up, used or not.
-                self.intersect_coherent::<8>(rays, group, hits, stack);
-            } else if group.count_ones() <= 16 {
-                self.intersect_coherent::<16>(rays, group, hits, stack);
-            } else {
-                self.intersect_coherent::<PACKET_SIZE>(rays, group, hits, stack);
-            }
-        }
-    }
-
-    /// The closest hits of the rays of `group` (a bit mask into `rays`, at most `N` set;
-    /// directions in one octant), traversing once for all. Each ray meets the triangles of the
-    /// leaves it enters with the same test as alone.
-    #[inline(always)]
-    fn intersect_coherent<const N: usize>(
+    pub(super) fn intersect_many<L: Lanes8>(
         &self,
+        l: L,
         rays: &[Ray],
-        group: u32,
         hits: &mut [Option<Hit>],
         stack: &mut TraversalStack,
     ) {
-        debug_assert!(group.count_ones() as usize <= N);
-        // Unused slots repeat the first ray.
-        let mut index = [group.trailing_zeros() as usize; N];
-        let n = group.count_ones() as usize;
-        for (slot, i) in index.iter_mut().zip(set_bits(group)) {
-            *slot = i;
-        }
-        let packet: [CoherentRay; N] = std::array::from_fn(
-            #[inline(always)]
-            |k| CoherentRay::new(&rays[index[k]]),
-        );
-        let mut t_max = index.map(|i| rays[i].t_max);
-        for &i in &index[..n] {
-            hits[i] = None;
-        }
-        let farthest = |t: &[f32]| t.iter().fold(0.0f32, |a, &b| a.max(b));
-        self.traverse::<true>(
-            &PacketBoxes::new(&packet[..n]),
-            farthest(&t_max[..n]),
-            stack,
-            #[inline(always)]
-            |leaf, packet_t_max| {
-                let (bounds, triangles) =
-                    (&self.leaves[(leaf & LEAF_INDEX) as usize], &self.packets[(leaf & LEAF_INDEX) as usize]);
-                for (k, ray) in packet[..n].iter().enumerate() {
-                    if !ray.enters(bounds, t_max[k]) {
-                        continue;
-                    }
-                    if let Some(PacketHit { lane, t, b1, b2 }) = ray.shear.intersect(&triangles.triangles, t_max[k]) {
-                        hits[index[k]] = Some(Hit { primitive: triangles.ids[lane], t, b1, b2 });
-                        t_max[k] = t;
-                    }
+        for group in coherent_groups(rays) {
+            // Packets in arrays of their size: each slot's ray is set up, used or not.
+            match group.count_ones() {
+                1 => {
+                    let i = group.trailing_zeros() as usize;
+                    hits[i] = self.intersect(&rays[i], stack);
                 }
-                *packet_t_max = farthest(&t_max[..n]);
-                false
-            },
-        );
+                2..=8 => self.intersect_coherent::<L, 8, 1>(l, rays, group, hits, stack),
+                9..=16 => self.intersect_coherent::<L, 16, 2>(l, rays, group, hits, stack),
+                17..=24 => self.intersect_coherent::<L, 24, 3>(l, rays, group, hits, stack),
+                _ => self.intersect_coherent::<L, 32, 4>(l, rays, group, hits, stack),
+            }
+        }
     }
 
     /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(its entry, t_max)`
@@ -615,85 +510,6 @@ impl Bvh4 {
                 walk.current = next;
                 return true;
             }
-        }
-    }
-}
-
-/// One ray's query in progress ([`interleave`]): the ray's index, its per-ray constants, where
-/// its traversal stands, and its answer so far (`A`: the closest hit, or whether it is blocked).
-struct Query<A> {
-    ray: usize,
-    boxes: RayBoxes,
-    shear: RayShear,
-    walk: Walk,
-    answer: A,
-}
-
-impl<A> Query<A> {
-    /// The query of ray `i` of `rays`, at the root, its answer `answer` until it finds another.
-    #[inline(always)]
-    fn new(rays: &[Ray], i: usize, answer: A) -> Self {
-        let ray = &rays[i];
-        Query { ray: i, boxes: RayBoxes::new(ray), shear: RayShear::new(ray), walk: Walk::new(ray.t_max), answer }
-    }
-}
-
-/// Run `count` queries two at a time, their steps interleaved: query `i` starts as `start(i)`,
-/// advances by `step(query, its stack)` until that returns false, and hands its answer to
-/// `finish`; a finished query's place goes to the next. A traversal step is a chain of dependent
-/// loads and tests, which leaves the core idle while one ray waits on its node; the other ray's
-/// steps fill that time. Each query takes the steps it takes alone, so gives the same answer.
-/// (Two queries in named variables: held in an array, indexed in a loop, they ran slower, and
-/// so did four, and three in named variables.)
-#[inline(always)]
-fn interleave<Q>(
-    count: usize,
-    stacks: &mut [TraversalStack; 2],
-    start: impl Fn(usize) -> Q,
-    mut step: impl FnMut(&mut Q, &mut TraversalStack) -> bool,
-    mut finish: impl FnMut(&Q),
-) {
-    let [stack_a, stack_b] = stacks;
-    if count < 2 {
-        for i in 0..count {
-            let mut query = start(i);
-            stack_a.clear();
-            while step(&mut query, stack_a) {}
-            finish(&query);
-        }
-        return;
-    }
-    let (mut a, mut b) = (start(0), start(1));
-    stack_a.clear();
-    stack_b.clear();
-    let mut next = 2;
-    loop {
-        let a_goes_on = step(&mut a, stack_a);
-        let b_goes_on = step(&mut b, stack_b);
-        if !a_goes_on {
-            finish(&a);
-            if next == count {
-                // No query left to start: the other runs to its end.
-                if b_goes_on {
-                    while step(&mut b, stack_b) {}
-                }
-                finish(&b);
-                return;
-            }
-            a = start(next);
-            stack_a.clear();
-            next += 1;
-        }
-        if !b_goes_on {
-            finish(&b);
-            if next == count {
-                while step(&mut a, stack_a) {}
-                finish(&a);
-                return;
-            }
-            b = start(next);
-            stack_b.clear();
-            next += 1;
         }
     }
 }
@@ -844,7 +660,7 @@ impl Builder<'_> {
             out.planes.push(plane);
             out.planes.len() as u32 - 1
         });
-        out.leaves.push(Leaf { plane, lo, hi });
+        out.leaves.push(Leaf { plane, bounds: [lo.x, hi.x, lo.y, hi.y, lo.z, hi.z] });
         let index = out.leaves.len() as u32 - 1;
         debug_assert!(index <= LEAF_INDEX, "more leaves than MAX_TRIANGLES allows");
         (LEAF | if plane.is_some() { PLANE } else { 0 } | index, lo, hi)
@@ -876,7 +692,7 @@ mod tests {
                     for o in [Vec3::splat(-5.0), Vec3::new(3.0, -2.0, 7.0), Vec3::splat(0.25), Vec3::splat(1e6)] {
                         let (mask, _) = RayBoxes::new(&Ray::new(o, d)).test(root, f32::INFINITY);
                         assert_eq!(mask & !used, 0, "an unused slot entered from {o} along {d}");
-                        let packet = [CoherentRay::new(&Ray::new(o, d)), CoherentRay::new(&Ray::new(o + 0.01, d))];
+                        let packet = [SlabRay::new(&Ray::new(o, d)), SlabRay::new(&Ray::new(o + 0.01, d))];
                         let (mask, _) = PacketBoxes::new(&packet).test(root, f32::INFINITY);
                         assert_eq!(mask & !used, 0, "an unused slot entered by a packet from {o} along {d}");
                     }
@@ -927,9 +743,11 @@ mod tests {
             let why = format!("the box [{lo}, {hi}] missed by the ray from {o} along {d} through {corner}");
             assert_eq!(RayBoxes::new(&ray).test(root, f32::INFINITY).0, used, "{why}");
             // A packet's node test, and its rays' leaf test.
-            let packet = [CoherentRay::new(&ray), CoherentRay::new(&ray)];
+            let packet = [SlabRay::new(&ray), SlabRay::new(&ray)];
             assert_eq!(PacketBoxes::new(&packet).test(root, f32::INFINITY).0, used, "packet: {why}");
-            assert!(packet[0].enters(&bvh.leaves[0], f32::INFINITY), "leaf: {why}");
+            for isa in [crate::simd::Isa::Avx2, crate::simd::Isa::Portable] {
+                assert!(packets::lanes_enter(isa, &ray, &bvh.leaves[0].bounds), "leaf, {isa:?}: {why}");
+            }
             tested += 1;
         }
     }

@@ -16,7 +16,7 @@ mod spheres;
 mod watertight;
 
 use crate::geometry::{Ray, Sphere};
-use crate::simd::Isa;
+use crate::simd::{Isa, LaneKernel, Lanes8};
 use bvh4::Bvh4;
 use glam::Vec3;
 use obvhs::{BvhBuildParams, triangle::Triangle};
@@ -123,14 +123,14 @@ impl Accel {
         }
     }
 
-    /// Run `f` with ray queries that share this thread's traversal stacks: a batch of queries
-    /// (a stage of the wavefront) takes them once, rather than once per ray.
+    /// Run `f` with ray queries that share this thread's traversal stack: a batch of queries
+    /// (a stage of the wavefront) takes it once, rather than once per ray.
     #[inline]
     pub fn queries<R>(&self, f: impl FnOnce(&mut Queries<'_>) -> R) -> R {
-        TRAVERSAL_STACKS.with(|cell| match cell.try_borrow_mut() {
-            Ok(mut stacks) => f(&mut Queries { accel: self, stacks: &mut stacks }),
-            // Queries started inside `f` (none of tessera's do) get stacks of their own.
-            Err(_) => f(&mut Queries { accel: self, stacks: &mut Default::default() }),
+        TRAVERSAL_STACK.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut stack) => f(&mut Queries { accel: self, stack: &mut stack }),
+            // Queries started inside `f` (none of tessera's do) get a stack of their own.
+            Err(_) => f(&mut Queries { accel: self, stack: &mut Default::default() }),
         })
     }
 
@@ -174,10 +174,10 @@ impl Accel {
     }
 }
 
-/// Ray queries into an [`Accel`] that share the traversal stacks of a thread ([`Accel::queries`]).
+/// Ray queries into an [`Accel`] that share the traversal stack of a thread ([`Accel::queries`]).
 pub struct Queries<'a> {
     accel: &'a Accel,
-    stacks: &'a mut [TraversalStack; 2],
+    stack: &'a mut TraversalStack,
 }
 
 impl Queries<'_> {
@@ -187,7 +187,7 @@ impl Queries<'_> {
         let accel = self.accel;
         let triangle = match &accel.backend {
             Backend::Empty => None,
-            Backend::Bvh4(bvh) => bvh.intersect(ray, &mut self.stacks[0]),
+            Backend::Bvh4(bvh) => bvh.intersect(ray, self.stack),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.intersect(ray),
         };
@@ -195,48 +195,25 @@ impl Queries<'_> {
     }
 
     /// [`Accel::intersect_many`]. Batches of queries (this, [`Queries::intersect_each`],
-    /// [`Queries::occluded_each`]) run compiled for the lanes' instruction set
-    /// ([`Isa::selected`]): under AVX2, the traversal's SSE operations in VEX form, whose three
-    /// operands spare the copies of two-operand SSE (4.9% fewer instructions on scene A). The
-    /// operations are the same (LLVM contracts no multiply-add), so are the answers.
+    /// [`Queries::occluded_each`]) run with the lanes' instruction set ([`Isa::selected`],
+    /// [`Isa::run_lanes`]): under AVX2, eight rays' box and triangle tests in 256-bit lanes, and
+    /// the single-ray traversal's SSE operations in VEX form. The operations are the same
+    /// either way (LLVM contracts no multiply-add), so are the answers.
     pub fn intersect_many(&mut self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit per ray");
-        let accel = self.accel;
-        Isa::selected().run(
-            #[inline(always)]
-            || {
-                for (rays, hits) in rays.chunks(32).zip(hits.chunks_mut(32)) {
-                    match &accel.backend {
-                        Backend::Bvh4(bvh) => {
-                            bvh.intersect_many(rays, hits, &mut self.stacks[0]);
-                            for (r, h) in rays.iter().zip(hits) {
-                                *h = accel.closer_sphere(r, *h);
-                            }
-                        }
-                        _ => {
-                            for (r, h) in rays.iter().zip(hits) {
-                                *h = self.intersect(r);
-                            }
-                        }
-                    }
-                }
-            },
-        )
+        Isa::selected().run_lanes(CoherentBatch { queries: self, rays, hits })
     }
 
     /// The closest hit of each of `rays` into `hits` (of the same length), as
-    /// [`Queries::intersect`] gives it; Embree traces them eight at a time, as packets, the
-    /// four-wide BVH two at a time, their traversals interleaved (packets of rays that diverge
-    /// measured slower).
+    /// [`Queries::intersect`] gives it (but for which of two triangles at exactly the same
+    /// distance it reports); both backends trace them eight at a time, as packets, the four-wide
+    /// BVH after sorting them by direction.
     pub fn intersect_each(&mut self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit per ray");
         let accel = self.accel;
         match &accel.backend {
             Backend::Empty => hits.fill(None),
-            Backend::Bvh4(bvh) => Isa::selected().run(
-                #[inline(always)]
-                || bvh.intersect_each(rays, hits, self.stacks),
-            ),
+            Backend::Bvh4(bvh) => Isa::selected().run_lanes(bvh4::Batch::<bvh4::Closest> { bvh, rays, answers: hits }),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => {
                 for (rays, hits) in rays.chunks(embree::PACKET).zip(hits.chunks_mut(embree::PACKET)) {
@@ -250,17 +227,16 @@ impl Queries<'_> {
     }
 
     /// Whether each of `rays` is blocked ([`Queries::occluded`]), into `blocked` (of the same
-    /// length); Embree tests them eight at a time as packets, the four-wide BVH two at a time,
-    /// their traversals interleaved.
+    /// length); both backends test them eight at a time, as packets, the four-wide BVH after
+    /// sorting them by direction.
     pub fn occluded_each(&mut self, rays: &[Ray], blocked: &mut [bool]) {
         assert_eq!(rays.len(), blocked.len(), "one answer per ray");
         let accel = self.accel;
         match &accel.backend {
             Backend::Empty => blocked.fill(false),
-            Backend::Bvh4(bvh) => Isa::selected().run(
-                #[inline(always)]
-                || bvh.occluded_each(rays, blocked, self.stacks),
-            ),
+            Backend::Bvh4(bvh) => {
+                Isa::selected().run_lanes(bvh4::Batch::<bvh4::Occluded> { bvh, rays, answers: blocked })
+            }
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => {
                 for (rays, blocked) in rays.chunks(embree::PACKET).zip(blocked.chunks_mut(embree::PACKET)) {
@@ -279,7 +255,7 @@ impl Queries<'_> {
         let accel = self.accel;
         let triangle = match &accel.backend {
             Backend::Empty => false,
-            Backend::Bvh4(bvh) => bvh.occluded(ray, &mut self.stacks[0]),
+            Backend::Bvh4(bvh) => bvh.occluded(ray, self.stack),
             #[cfg(feature = "embree")]
             Backend::Embree(scene) => scene.occluded(ray),
         };
@@ -287,15 +263,44 @@ impl Queries<'_> {
     }
 }
 
+/// [`Queries::intersect_many`], compiled for the lanes' instruction set.
+struct CoherentBatch<'q, 'a, 'b> {
+    queries: &'q mut Queries<'a>,
+    rays: &'b [Ray],
+    hits: &'b mut [Option<Hit>],
+}
+
+impl LaneKernel for CoherentBatch<'_, '_, '_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: Lanes8>(self, l: L) {
+        let CoherentBatch { queries, rays, hits } = self;
+        let accel = queries.accel;
+        for (rays, hits) in rays.chunks(32).zip(hits.chunks_mut(32)) {
+            match &accel.backend {
+                Backend::Bvh4(bvh) => {
+                    bvh.intersect_many(l, rays, hits, queries.stack);
+                    for (r, h) in rays.iter().zip(hits) {
+                        *h = accel.closer_sphere(r, *h);
+                    }
+                }
+                _ => {
+                    for (r, h) in rays.iter().zip(hits) {
+                        *h = queries.intersect(r);
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// A traversal stack of (child, entry distance) pairs ([`bvh4`]).
 type TraversalStack = Vec<(u32, f32)>;
 
 thread_local! {
-    /// Each thread's traversal stacks (two, for the interleaved traversals of
-    /// [`Queries::intersect_each`]), reused by every batch of queries so that none allocates or
-    /// initialises one.
-    static TRAVERSAL_STACKS: std::cell::RefCell<[TraversalStack; 2]> =
-        const { std::cell::RefCell::new([Vec::new(), Vec::new()]) };
+    /// Each thread's traversal stack, reused by every batch of queries so that none allocates
+    /// one.
+    static TRAVERSAL_STACK: std::cell::RefCell<TraversalStack> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// obvhs's binary BVH (leaves of up to four triangles: one packet), collapsed four-wide; the
@@ -510,8 +515,8 @@ mod tests {
                 // Stale answers in the output, which every query must overwrite.
                 let mut hits = vec![Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }); n];
                 accel.intersect_many(&rays, &mut hits);
-                // The wavefront's bounce and shadow queries: Embree's packets of eight, the
-                // four-wide BVH's interleaved pairs (odd counts end on one ray alone).
+                // The wavefront's bounce and shadow queries: packets of eight (short ones at the
+                // ends of a batch and, in the four-wide BVH, of an octant).
                 let mut each = hits.clone();
                 each.iter_mut().for_each(|h| *h = Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }));
                 let mut blocked = vec![true; n];

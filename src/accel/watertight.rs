@@ -28,6 +28,32 @@ impl TrianglePacket {
     }
 }
 
+impl TrianglePacket {
+    /// Coordinate `axis` of vertex `vertex` of the triangle in lane `lane`.
+    #[inline(always)]
+    pub(super) fn coordinate(&self, vertex: usize, axis: usize, lane: usize) -> f32 {
+        self.v[vertex][axis].as_ref()[lane]
+    }
+}
+
+/// The paper's permutation of the axes for a ray along `d`: [kx, ky, kz], kz the axis of the
+/// largest component, kx and ky the other two in cyclic order, swapped where `d[kz]` is negative
+/// so that the winding is kept.
+#[inline(always)]
+pub(super) fn permutation(d: Vec3) -> [usize; 3] {
+    let a = d.abs();
+    let kz = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    const CYCLIC: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
+    let [kx, ky] = CYCLIC[kz];
+    if d[kz] < 0.0 { [ky, kx, kz] } else { [kx, ky, kz] }
+}
+
 /// A hit on one lane of a packet.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct PacketHit {
@@ -59,23 +85,8 @@ pub(super) struct RayShear {
 impl RayShear {
     pub(super) fn new(ray: &Ray) -> Self {
         let (d, o) = (ray.d.to_array(), ray.o.to_array());
-        let a = ray.d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        // The other two axes in cyclic order, swapped when the dominant component is negative
-        // so that the winding is kept.
-        const CYCLIC: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
-        let [mut kx, mut ky] = CYCLIC[kz];
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let k @ [kx, ky, kz] = permutation(ray.d);
         let sz = 1.0 / d[kz];
-        let k = [kx, ky, kz];
         RayShear { k, origin: k.map(|axis| Vec4::splat(o[axis])), shear: [d[kx] * sz, d[ky] * sz, sz].map(Vec4::splat) }
     }
 

@@ -2,6 +2,8 @@
 //! time: AVX2 where the CPU has it, else the baseline (SSE2 on x86-64, whatever the target has
 //! elsewhere). Either can be asked for, so that tests and benchmarks compare them.
 
+use super::LaneKernel;
+
 /// An instruction set for lane code ([`Isa::run`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
@@ -68,6 +70,23 @@ impl Isa {
             return unsafe { with_avx2(f) };
         }
         f()
+    }
+
+    /// `kernel`, with AVX2's operations ([`super::Avx2Lanes`], the kernel compiled for them)
+    /// under [`Isa::Avx2`] where the CPU runs them, else the portable ones, which give the same
+    /// bits.
+    #[inline(always)]
+    pub fn run_lanes<K: LaneKernel>(self, kernel: K) -> K::Output {
+        #[cfg(target_arch = "x86_64")]
+        if self == Isa::Avx2
+            && let Some(lanes) = super::Avx2Lanes::new()
+        {
+            return lanes.0.vectorize(
+                #[inline(always)]
+                move || kernel.run(lanes),
+            );
+        }
+        kernel.run(super::PortableLanes)
     }
 }
 

@@ -12,9 +12,13 @@
 mod dispatch;
 mod lanes;
 pub mod trig;
+mod wide;
 
 pub use dispatch::Isa;
 pub use lanes::{F32x8, M32x8};
+#[cfg(target_arch = "x86_64")]
+pub use wide::Avx2Lanes;
+pub use wide::{LaneKernel, Lanes8, PortableLanes};
 
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
