@@ -258,13 +258,21 @@ const PACKET_SIZE: usize = 32;
 /// packets (bounces, shadow rays) measured slower than their rays traced alone.
 const COHERENT_COS: f32 = 0.999;
 
+/// The octant of a ray's direction, by the sign bits of its components: a -0 counts as
+/// negative, as it does for the reciprocal that box tests take (`SlabRay`), so that the rays of
+/// one octant agree on each axis's near plane.
+#[inline(always)]
+fn octant(ray: &Ray) -> usize {
+    ray.d.is_negative_bitmask() as usize
+}
+
 /// The rays of `rays` (at most 32), grouped into packets that [`PacketBoxes`] bounds tightly:
 /// one octant, directions within `COHERENT_COS` of the group's first; each group a bit mask.
 fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
     debug_assert!(rays.len() <= 32);
     let mut by_octant = [0u32; 8];
     for (i, r) in rays.iter().enumerate() {
-        by_octant[r.d.cmplt(Vec3::ZERO).bitmask() as usize] |= 1 << i;
+        by_octant[octant(r)] |= 1 << i;
     }
     let mut octant = 0;
     std::iter::from_fn(

@@ -537,6 +537,45 @@ mod tests {
     }
 
     #[test]
+    fn packets_of_rays_with_signed_zero_components_match_single_ray_queries() {
+        // Rays alike but for one component, +0, -0 or tiny of either sign: packets are formed by
+        // octant, and a packet's box tests take each axis's near plane from the sign of its
+        // rays' reciprocals, which a -0 component makes negative.
+        let mut rng = Lcg(29);
+        let tris = random_scene(&mut rng, 400);
+        let parts = [0.0, -0.0, 1e-7, -1e-7];
+        for (kind, accel) in each_kind(&tris) {
+            let mut hits_seen = 0;
+            for batch in 0..300 {
+                let (o, target) = (rng.vec(16.0), rng.vec(6.0));
+                let axis = batch % 3;
+                let rays: Vec<Ray> = (0..32)
+                    .map(|i| {
+                        let mut d = (target - o).normalize();
+                        d[axis] = parts[(i + batch) % parts.len()];
+                        Ray::new(o + rng.vec(0.01), d)
+                    })
+                    .collect();
+                let mut many = vec![None; rays.len()];
+                accel.intersect_many(&rays, &mut many);
+                let (mut each, mut blocked) = (vec![None; rays.len()], vec![false; rays.len()]);
+                accel.queries(|q| {
+                    q.intersect_each(&rays, &mut each);
+                    q.occluded_each(&rays, &mut blocked);
+                });
+                for (i, ray) in rays.iter().enumerate() {
+                    let single = accel.intersect(ray);
+                    assert_eq!(many[i], single, "{kind:?}: ray {i} of batch {batch}: {ray:?}");
+                    assert_eq!(each[i], single, "{kind:?}: ray {i} of batch {batch} (each): {ray:?}");
+                    assert_eq!(blocked[i], single.is_some(), "{kind:?}: ray {i} of batch {batch} (occluded)");
+                    hits_seen += single.is_some() as u32;
+                }
+            }
+            assert!(hits_seen > 1000, "{kind:?}: only {hits_seen} hits");
+        }
+    }
+
+    #[test]
     fn spheres_among_triangles_are_hit_as_brute_force_finds_them() {
         let mut rng = Lcg(23);
         let tris = random_scene(&mut rng, 500);

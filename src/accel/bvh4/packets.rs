@@ -5,12 +5,13 @@
 //!
 //! The lanes are [`Lanes8`]'s: AVX2 instructions where the CPU has them, a portable twin with the
 //! same bits elsewhere. Each lane runs the operations of the single-ray tests in the same order
-//! (the robust box test of [`super::RayBoxes`], the watertight test of [`RayShear`]), so a ray's
+//! (the robust box test of [`super::RayBoxes`], the watertight test of
+//! [`super::super::watertight::RayShear`]), so a ray's
 //! answer is the single-ray query's, but for which of two triangles at exactly the same
 //! distance it reports (the packet visits leaves in its own order).
 
 use super::super::watertight::TrianglePacket;
-use super::{Bvh4, LEAF, LEAF_INDEX, Node, PLANE, Packet, PacketBoxes, ROBUST_FAR, SlabRay, TraversalStack};
+use super::{Bvh4, LEAF, LEAF_INDEX, Node, PLANE, Packet, PacketBoxes, ROBUST_FAR, SlabRay, TraversalStack, octant};
 use crate::accel::Hit;
 use crate::geometry::Ray;
 use crate::simd::{Lanes8, set_bits};
@@ -66,7 +67,7 @@ fn either<L: Lanes8>(l: L, swap: L::M, unswapped: L::M, swapped: L::M) -> L::M {
 /// The rays of a packet, one to eight, and the first again in the lanes beyond them. (The lanes
 /// are read from where the rays lie, not from a copy: a copy's narrow stores would hold up the
 /// wider loads that read them back.)
-pub(super) struct PacketRays<'a> {
+struct PacketRays<'a> {
     lanes: [&'a Ray; PACKET],
     count: usize,
 }
@@ -86,7 +87,7 @@ impl<'a> PacketRays<'a> {
     }
 }
 
-/// Eight rays' constants, lane i for ray i: those of [`super::SlabRay`] and of [`RayShear`],
+/// Eight rays' constants, lane i for ray i: those of [`super::SlabRay`] and of `RayShear`,
 /// computed in lanes by the same operations.
 struct RayLanes<L: Lanes8> {
     /// Per axis: the origin, from which near planes are measured.
@@ -589,14 +590,6 @@ fn in_packets<A: Copy>(rays: &[Ray], answers: &mut [A], empty: A, mut trace: imp
     for (&i, answer) in order.iter().zip(sorted_answers) {
         answers[i as usize] = answer;
     }
-}
-
-/// The octant of a ray's direction, by the signs of its components (a zero's sign counts, as it
-/// does for the sign of the reciprocal that the box test takes).
-fn octant(r: &Ray) -> usize {
-    r.d.x.is_sign_negative() as usize
-        | (r.d.y.is_sign_negative() as usize) << 1
-        | (r.d.z.is_sign_negative() as usize) << 2
 }
 
 /// Bins per axis of [`by_direction`]'s key.
