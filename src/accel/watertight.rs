@@ -26,9 +26,7 @@ impl TrianglePacket {
         });
         TrianglePacket { v }
     }
-}
 
-impl TrianglePacket {
     /// Coordinate `axis` of vertex `vertex` of the triangle in lane `lane`.
     #[inline(always)]
     pub(super) fn coordinate(&self, vertex: usize, axis: usize, lane: usize) -> f32 {

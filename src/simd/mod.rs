@@ -8,6 +8,10 @@
 //! halves) where not ([`Isa`]); both run the same IEEE operations in the same order, so they
 //! agree bit for bit. Lanes differ from `f32` only in [`Real::sin_cos`]: libm's for `f32`, a
 //! polynomial in lanes ([`trig`]). An RGB colour is a [`Real`] too, its channels being lanes.
+//!
+//! Kernels whose lanes LLVM would split and spill (the ray packets' traversal) are written over
+//! [`Lanes8`] instead, whose operations are named AVX2 instructions or their portable twins
+//! (`wide.rs`).
 
 mod dispatch;
 mod lanes;
