@@ -487,6 +487,29 @@ mod tests {
         assert!(blocked.iter().all(|&n| n > 2000), "both answers should be common: {blocked:?}");
     }
 
+    /// Check every batched query of `rays` (the camera rays' `intersect_many`, the wavefront's
+    /// `intersect_each` and `occluded_each`, each writing over stale answers) against the
+    /// single-ray query; how many rays hit something.
+    fn assert_batches_match_single_rays(accel: &Accel, rays: &[Ray], what: &str) -> u32 {
+        let stale = Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 });
+        let (mut many, mut each, mut blocked) =
+            (vec![stale; rays.len()], vec![stale; rays.len()], vec![true; rays.len()]);
+        accel.intersect_many(rays, &mut many);
+        accel.queries(|q| {
+            q.intersect_each(rays, &mut each);
+            q.occluded_each(rays, &mut blocked);
+        });
+        let mut hits = 0;
+        for (i, ray) in rays.iter().enumerate() {
+            let single = accel.intersect(ray);
+            assert_eq!(many[i], single, "{what}: ray {i}: {ray:?}");
+            assert_eq!(each[i], single, "{what}: ray {i} (each): {ray:?}");
+            assert_eq!(blocked[i], accel.occluded(ray), "{what}: ray {i} (occluded)");
+            hits += single.is_some() as u32;
+        }
+        hits
+    }
+
     #[test]
     fn batched_queries_match_single_ray_queries() {
         // Batches of up to 32 rays: bundles around a few directions (traced as packets, some
@@ -512,25 +535,7 @@ mod tests {
                         ray
                     })
                     .collect();
-                // Stale answers in the output, which every query must overwrite.
-                let mut hits = vec![Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }); n];
-                accel.intersect_many(&rays, &mut hits);
-                // The wavefront's bounce and shadow queries: packets of eight (short ones at the
-                // ends of a batch and, in the four-wide BVH, of an octant).
-                let mut each = hits.clone();
-                each.iter_mut().for_each(|h| *h = Some(Hit { t: 1.0, primitive: 0, b1: 0.0, b2: 0.0 }));
-                let mut blocked = vec![true; n];
-                accel.queries(|q| {
-                    q.intersect_each(&rays, &mut each);
-                    q.occluded_each(&rays, &mut blocked);
-                });
-                for (i, ray) in rays.iter().enumerate() {
-                    let single = accel.intersect(ray);
-                    assert_eq!(hits[i], single, "{kind:?}: ray {i} of batch {batch}: {ray:?}");
-                    assert_eq!(each[i], single, "{kind:?}: ray {i} of batch {batch} (each): {ray:?}");
-                    assert_eq!(blocked[i], accel.occluded(ray), "{kind:?}: ray {i} of batch {batch} (occluded)");
-                    hits_seen += hits[i].is_some() as u32;
-                }
+                hits_seen += assert_batches_match_single_rays(&accel, &rays, &format!("{kind:?}, batch {batch}"));
             }
             assert!(hits_seen > 2000, "{kind:?}: only {hits_seen} hits");
         }
@@ -556,20 +561,7 @@ mod tests {
                         Ray::new(o + rng.vec(0.01), d)
                     })
                     .collect();
-                let mut many = vec![None; rays.len()];
-                accel.intersect_many(&rays, &mut many);
-                let (mut each, mut blocked) = (vec![None; rays.len()], vec![false; rays.len()]);
-                accel.queries(|q| {
-                    q.intersect_each(&rays, &mut each);
-                    q.occluded_each(&rays, &mut blocked);
-                });
-                for (i, ray) in rays.iter().enumerate() {
-                    let single = accel.intersect(ray);
-                    assert_eq!(many[i], single, "{kind:?}: ray {i} of batch {batch}: {ray:?}");
-                    assert_eq!(each[i], single, "{kind:?}: ray {i} of batch {batch} (each): {ray:?}");
-                    assert_eq!(blocked[i], single.is_some(), "{kind:?}: ray {i} of batch {batch} (occluded)");
-                    hits_seen += single.is_some() as u32;
-                }
+                hits_seen += assert_batches_match_single_rays(&accel, &rays, &format!("{kind:?}, batch {batch}"));
             }
             assert!(hits_seen > 1000, "{kind:?}: only {hits_seen} hits");
         }
