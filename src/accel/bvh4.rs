@@ -50,6 +50,8 @@ const LEAF: u32 = 1 << 31;
 const PLANE: u32 = 1 << 30;
 /// The leaf index in a leaf's child entry.
 const LEAF_INDEX: u32 = PLANE - 1;
+/// The root node's index.
+const ROOT: u32 = 0;
 /// 1 + 2 gamma(3) with gamma(n) = n eps / (1 - n eps), eps = 2^-24 (Ize 2013).
 const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
@@ -337,11 +339,18 @@ impl Bvh4 {
     /// The closest hit with `0 < t < ray.t_max`.
     #[inline(always)]
     pub(super) fn intersect(&self, ray: &Ray, stack: &mut TraversalStack) -> Option<Hit> {
+        self.intersect_below(ray, ROOT, ray.t_max, stack)
+    }
+
+    /// The closest hit with `0 < t < t_max` among the triangles under `start` (a node, or a
+    /// leaf's entry).
+    #[inline(always)]
+    fn intersect_below(&self, ray: &Ray, start: u32, t_max: f32, stack: &mut TraversalStack) -> Option<Hit> {
         let shear = RayShear::new(ray);
         let mut closest: Option<Hit> = None;
         self.traverse::<true>(
             &RayBoxes::new(ray),
-            ray.t_max,
+            Walk { current: start, t_max },
             stack,
             #[inline(always)]
             |leaf, t_max| {
@@ -355,11 +364,18 @@ impl Bvh4 {
     /// Whether anything lies on the ray with `0 < t < ray.t_max`.
     #[inline(always)]
     pub(super) fn occluded(&self, ray: &Ray, stack: &mut TraversalStack) -> bool {
+        self.occluded_below(ray, ROOT, stack)
+    }
+
+    /// Whether a triangle under `start` (a node, or a leaf's entry) lies on the ray with
+    /// `0 < t < ray.t_max`.
+    #[inline(always)]
+    fn occluded_below(&self, ray: &Ray, start: u32, stack: &mut TraversalStack) -> bool {
         let shear = RayShear::new(ray);
         let mut blocked = false;
         self.traverse::<false>(
             &RayBoxes::new(ray),
-            ray.t_max,
+            Walk { current: start, t_max: ray.t_max },
             stack,
             #[inline(always)]
             |leaf, t_max| {
@@ -421,21 +437,20 @@ impl Bvh4 {
         }
     }
 
-    /// Visit the leaves whose boxes `boxes` lets through, calling `leaf(its entry, t_max)`
-    /// ([`LEAF`]), which may shorten `t_max` to a hit and returns true to end the traversal.
-    /// With `CLOSEST`, children are visited nearest first and boxes beyond `t_max` are skipped;
-    /// without, in any order (a shadow ray needs any hit, not the nearest). `stack` holds the
-    /// children still to visit.
+    /// Visit the leaves under `walk`'s node whose boxes `boxes` lets through, calling `leaf(its
+    /// entry, t_max)` ([`LEAF`]), which may shorten `t_max` to a hit and returns true to end the
+    /// traversal. With `CLOSEST`, children are visited nearest first and boxes beyond `t_max`
+    /// are skipped; without, in any order (a shadow ray needs any hit, not the nearest). `stack`
+    /// holds the children still to visit.
     #[inline(always)]
     fn traverse<const CLOSEST: bool>(
         &self,
         boxes: &impl BoxTest,
-        t_max: f32,
+        mut walk: Walk,
         stack: &mut TraversalStack,
         mut leaf: impl FnMut(u32, &mut f32) -> bool,
     ) {
         stack.clear();
-        let mut walk = Walk::new(t_max);
         while self.step::<CLOSEST>(
             boxes,
             &mut walk,
@@ -527,13 +542,6 @@ impl Bvh4 {
 struct Walk {
     current: u32,
     t_max: f32,
-}
-
-impl Walk {
-    /// A traversal from the root.
-    fn new(t_max: f32) -> Self {
-        Walk { current: 0, t_max }
-    }
 }
 
 /// Triangles under each node of a binary BVH.

@@ -11,7 +11,9 @@
 //! distance it reports (the packet visits leaves in its own order).
 
 use super::super::watertight::TrianglePacket;
-use super::{Bvh4, LEAF, LEAF_INDEX, Node, PLANE, Packet, PacketBoxes, ROBUST_FAR, SlabRay, TraversalStack, octant};
+use super::{
+    Bvh4, LEAF, LEAF_INDEX, Node, PLANE, Packet, PacketBoxes, ROBUST_FAR, ROOT, SlabRay, TraversalStack, Walk, octant,
+};
 use crate::accel::Hit;
 use crate::geometry::Ray;
 use crate::simd::{Lanes8, set_bits};
@@ -26,6 +28,20 @@ pub(in crate::accel) struct Pending<F> {
     node: u32,
     lanes: u32,
     t_near: F,
+}
+
+/// The scratch of a packet's traversal: the entries still to visit, and the stack of a ray
+/// that goes on alone ([`Bvh4::traverse_packet`]).
+pub(in crate::accel) struct PacketStacks<F> {
+    packet: Vec<Pending<F>>,
+    alone: TraversalStack,
+}
+
+impl<F> PacketStacks<F> {
+    /// Empty stacks, room for a deep tree's entries reserved.
+    fn new() -> Self {
+        PacketStacks { packet: Vec::with_capacity(64), alone: Vec::with_capacity(64) }
+    }
 }
 
 /// Each ray's view of the vertices of triangle `j` of `triangles` (RayShear::lane_hits):
@@ -265,6 +281,18 @@ impl<L: Lanes8> ClosestLanes<L> {
         }
     }
 
+    /// Make `hit` lane `lane`'s closest (found by the ray alone: its barycentrics unscaled).
+    #[inline(always)]
+    fn set(&mut self, l: L, lane: usize, hit: Hit) {
+        let only = l.mask(1 << lane);
+        self.t_max = l.select(only, l.splat(hit.t), self.t_max);
+        self.id = l.select(only, l.splat(f32::from_bits(hit.primitive)), self.id);
+        self.v = l.select(only, l.splat(hit.b1), self.v);
+        self.w = l.select(only, l.splat(hit.b2), self.w);
+        self.det = l.select(only, l.splat(1.0), self.det);
+        self.found |= 1 << lane;
+    }
+
     /// The hits of the first `n` lanes, as `(lane, hit)`.
     #[inline(always)]
     fn hits(&self, l: L, n: usize) -> impl Iterator<Item = (usize, Option<Hit>)> {
@@ -278,35 +306,46 @@ impl<L: Lanes8> ClosestLanes<L> {
 }
 
 impl Bvh4 {
-    /// The closest hit of each of `rays` (one to eight) into `hits`, as [`Bvh4::intersect`]
-    /// gives it but for ties in distance; `stack` is scratch.
+    /// The closest hit of each ray `rays[i]` for `i` in `packet` (one to eight) into `hits[i]`,
+    /// as [`Bvh4::intersect`] gives it but for ties in distance; `stacks` is scratch.
     #[inline(always)]
-    pub(in crate::accel) fn intersect_packet<L: Lanes8>(
+    fn intersect_packet<L: Lanes8>(
         &self,
         l: L,
         rays: &[Ray],
+        indices: &[u32],
         hits: &mut [Option<Hit>],
-        stack: &mut Vec<Pending<L::F>>,
+        stacks: &mut PacketStacks<L::F>,
     ) {
-        let packet = PacketRays::new(rays, 0..rays.len());
+        let packet = PacketRays::new(rays, indices.iter().map(|&i| i as usize));
         let lanes = RayLanes::new(l, &packet);
         let mut closest = ClosestLanes::new(l, &packet);
         let mut t_max = closest.t_max;
+        let PacketStacks { packet: stack, alone } = stacks;
         self.traverse_packet::<L, true>(
             l,
             &lanes,
+            (1 << indices.len()) - 1,
             &mut t_max,
             stack,
             #[inline(always)]
-            |leaf, entered, t_max| {
-                closest.t_max = *t_max;
-                closest.test(l, &lanes, &self.packets[(leaf & LEAF_INDEX) as usize], entered);
+            |entry, entered, t_max| {
+                if entry & LEAF == 0 && entered & (entered - 1) == 0 {
+                    let lane = entered.trailing_zeros() as usize;
+                    let ray_t_max = l.store(*t_max)[lane];
+                    if let Some(hit) = self.intersect_below(packet.lanes[lane], entry, ray_t_max, alone) {
+                        closest.set(l, lane, hit);
+                    }
+                } else {
+                    closest.t_max = *t_max;
+                    closest.test(l, &lanes, &self.packets[(entry & LEAF_INDEX) as usize], entered);
+                }
                 *t_max = closest.t_max;
                 false
             },
         );
-        for (i, hit) in closest.hits(l, rays.len()) {
-            hits[i] = hit;
+        for (i, hit) in closest.hits(l, indices.len()) {
+            hits[indices[i] as usize] = hit;
         }
     }
 
@@ -345,7 +384,7 @@ impl Bvh4 {
         let packet_t_max = index[..n].iter().fold(0.0f32, |a, &i| a.max(rays[i].t_max));
         self.traverse::<true>(
             &PacketBoxes::new(&slabs[..n]),
-            packet_t_max,
+            Walk { current: ROOT, t_max: packet_t_max },
             stack,
             #[inline(always)]
             |leaf, packet_t_max| {
@@ -375,39 +414,50 @@ impl Bvh4 {
         }
     }
 
-    /// Whether each of `rays` (one to eight) is blocked, into `blocked`, as [`Bvh4::occluded`]
-    /// answers; `stack` is scratch.
+    /// Whether each ray `rays[i]` for `i` in `indices` (one to eight) is blocked, into
+    /// `blocked[i]`, as [`Bvh4::occluded`] answers; `stacks` is scratch.
     #[inline(always)]
-    pub(in crate::accel) fn occluded_packet<L: Lanes8>(
+    fn occluded_packet<L: Lanes8>(
         &self,
         l: L,
         rays: &[Ray],
+        indices: &[u32],
         blocked: &mut [bool],
-        stack: &mut Vec<Pending<L::F>>,
+        stacks: &mut PacketStacks<L::F>,
     ) {
-        let n = rays.len();
-        let lanes = RayLanes::new(l, &PacketRays::new(rays, 0..rays.len()));
+        let n = indices.len();
+        let packet = PacketRays::new(rays, indices.iter().map(|&i| i as usize));
+        let lanes = RayLanes::new(l, &packet);
         let mut t_max = [f32::NEG_INFINITY; PACKET];
-        for (t, r) in t_max.iter_mut().zip(rays) {
+        for (t, r) in t_max.iter_mut().zip(&packet.lanes[..n]) {
             *t = r.t_max;
         }
         let ray_t_max = t_max;
         let mut t_max = l.load(t_max);
         let all = (1u32 << n) - 1;
         let mut found = 0u32;
+        let PacketStacks { packet: stack, alone } = stacks;
         self.traverse_packet::<L, false>(
             l,
             &lanes,
+            all,
             &mut t_max,
             stack,
             #[inline(always)]
-            |leaf, mut entered, t_max| {
-                let index = (leaf & LEAF_INDEX) as usize;
-                if leaf & PLANE != 0
+            |entry, mut entered, t_max| {
+                if entry & LEAF == 0 && entered & (entered - 1) == 0 {
+                    if self.occluded_below(packet.lanes[entered.trailing_zeros() as usize], entry, alone) {
+                        found |= entered;
+                        *t_max = l.select(l.mask(entered), l.splat(f32::NEG_INFINITY), *t_max);
+                    }
+                    return found == all;
+                }
+                let index = (entry & LEAF_INDEX) as usize;
+                if entry & PLANE != 0
                     && let Some(plane) = self.leaves[index].plane
                 {
                     for i in set_bits(entered) {
-                        if self.planes[plane as usize].clears(&rays[i], ray_t_max[i]) {
+                        if self.planes[plane as usize].clears(packet.lanes[i], ray_t_max[i]) {
                             entered &= !(1 << i);
                         }
                     }
@@ -428,28 +478,32 @@ impl Bvh4 {
                 found == all
             },
         );
-        for (i, b) in blocked.iter_mut().enumerate().take(n) {
-            *b = found & (1 << i) != 0;
+        for (i, &index) in indices.iter().enumerate() {
+            blocked[index as usize] = found & (1 << i) != 0;
         }
     }
 
-    /// Visit the leaves that the rays of `lanes` may meet, calling `leaf(its entry, the lanes
-    /// that entered it, t_max)`, which may shorten `t_max` and returns true to end the
-    /// traversal. With `CLOSEST`, children are visited nearest first (for the lowest lane that
-    /// enters any) and entries beyond every entering lane's `t_max` are skipped.
+    /// Visit the nodes and leaves that the rays of `lanes` (those of `live`) may meet, calling
+    /// `visit(its entry, the lanes that entered it, t_max)` for each leaf that several lanes
+    /// enter, and for each node or leaf that one lane enters alone, whose subtree that lane's
+    /// ray traverses alone (`visit`'s part: in a packet, it would test every box and triangle
+    /// in eight lanes for one ray's sake). `visit` may shorten `t_max`, and returns true to end
+    /// the traversal. With `CLOSEST`, children are visited nearest first (for the lowest lane
+    /// that enters any) and entries beyond every entering lane's `t_max` are skipped.
     #[inline(always)]
     fn traverse_packet<L: Lanes8, const CLOSEST: bool>(
         &self,
         l: L,
         lanes: &RayLanes<L>,
+        live: u32,
         t_max: &mut L::F,
         stack: &mut Vec<Pending<L::F>>,
-        mut leaf: impl FnMut(u32, u32, &mut L::F) -> bool,
+        mut visit: impl FnMut(u32, u32, &mut L::F) -> bool,
     ) {
         stack.clear();
-        let (mut current, mut entered) = (0u32, u32::MAX);
+        let (mut current, mut entered) = (ROOT, live);
         loop {
-            if current & LEAF == 0 {
+            if current & LEAF == 0 && entered & (entered - 1) != 0 {
                 let node = &self.nodes[current as usize];
                 let tests: [(u32, L::F); 4] = [
                     lanes.enter(l, node, 0, *t_max),
@@ -495,7 +549,7 @@ impl Bvh4 {
                     (current, entered) = (node.children[c], tests[c].0);
                     continue;
                 }
-            } else if leaf(current, entered, t_max) {
+            } else if visit(current, entered, t_max) {
                 return;
             }
             // Next: the latest entry some lane still enters before its t_max.
@@ -517,10 +571,15 @@ impl Bvh4 {
 pub(in crate::accel) trait PacketQuery {
     /// A ray's answer.
     type Answer: Copy;
-    /// The answer before the query: no hit, not blocked.
-    const NONE: Self::Answer;
-    /// Answer the rays of one packet.
-    fn trace<L: Lanes8>(bvh: &Bvh4, l: L, rays: &[Ray], answers: &mut [Self::Answer], stack: &mut Vec<Pending<L::F>>);
+    /// Answer the rays `rays[i]` for `i` in `indices` (one to eight), into `answers[i]`.
+    fn trace<L: Lanes8>(
+        bvh: &Bvh4,
+        l: L,
+        rays: &[Ray],
+        indices: &[u32],
+        answers: &mut [Self::Answer],
+        stacks: &mut PacketStacks<L::F>,
+    );
 }
 
 /// Closest hits ([`Bvh4::intersect_packet`]).
@@ -528,10 +587,16 @@ pub(in crate::accel) struct Closest;
 
 impl PacketQuery for Closest {
     type Answer = Option<Hit>;
-    const NONE: Option<Hit> = None;
     #[inline(always)]
-    fn trace<L: Lanes8>(bvh: &Bvh4, l: L, rays: &[Ray], hits: &mut [Option<Hit>], stack: &mut Vec<Pending<L::F>>) {
-        bvh.intersect_packet(l, rays, hits, stack);
+    fn trace<L: Lanes8>(
+        bvh: &Bvh4,
+        l: L,
+        rays: &[Ray],
+        indices: &[u32],
+        hits: &mut [Option<Hit>],
+        stacks: &mut PacketStacks<L::F>,
+    ) {
+        bvh.intersect_packet(l, rays, indices, hits, stacks);
     }
 }
 
@@ -540,14 +605,21 @@ pub(in crate::accel) struct Occluded;
 
 impl PacketQuery for Occluded {
     type Answer = bool;
-    const NONE: bool = false;
     #[inline(always)]
-    fn trace<L: Lanes8>(bvh: &Bvh4, l: L, rays: &[Ray], blocked: &mut [bool], stack: &mut Vec<Pending<L::F>>) {
-        bvh.occluded_packet(l, rays, blocked, stack);
+    fn trace<L: Lanes8>(
+        bvh: &Bvh4,
+        l: L,
+        rays: &[Ray],
+        indices: &[u32],
+        blocked: &mut [bool],
+        stacks: &mut PacketStacks<L::F>,
+    ) {
+        bvh.occluded_packet(l, rays, indices, blocked, stacks);
     }
 }
 
-/// The answers of query `Q` for a batch of rays, traced eight at a time ([`in_packets`]).
+/// The answers of query `Q` for a batch of rays, traced eight at a time in packets of rays
+/// alike ([`by_direction`], [`packet_end`]).
 pub(in crate::accel) struct Batch<'a, Q: PacketQuery> {
     pub bvh: &'a Bvh4,
     pub rays: &'a [Ray],
@@ -558,38 +630,29 @@ impl<Q: PacketQuery> crate::simd::LaneKernel for Batch<'_, Q> {
     type Output = ();
     #[inline(always)]
     fn run<L: Lanes8>(self, l: L) {
-        let mut stack = Vec::with_capacity(64);
-        in_packets(
-            self.rays,
-            self.answers,
-            Q::NONE,
-            #[inline(always)]
-            |rays, answers| Q::trace(self.bvh, l, rays, answers, &mut stack),
-        );
+        let mut stacks = PacketStacks::new();
+        let Batch { bvh, rays, answers } = self;
+        // Rays alike traced together: sorted by direction, then cut into packets.
+        let order = by_direction(rays);
+        let mut start = 0;
+        while start < order.len() {
+            let end = packet_end(rays, &order, start);
+            Q::trace(bvh, l, rays, &order[start..end], answers, &mut stacks);
+            start = end;
+        }
     }
 }
 
-/// `trace(packet, its answers)` over packets of `rays` alike, their answers put back in the
-/// order of `rays` into `answers`: the rays sorted by direction ([`by_direction`]), then cut
-/// into packets of up to eight rays of one octant.
+/// The end of the packet that starts at `order[start]`, in an order of `rays` by direction
+/// ([`by_direction`]): up to eight rays of one octant.
 #[inline(always)]
-fn in_packets<A: Copy>(rays: &[Ray], answers: &mut [A], empty: A, mut trace: impl FnMut(&[Ray], &mut [A])) {
-    let order = by_direction(rays);
-    let sorted: Vec<Ray> = order.iter().map(|&i| rays[i as usize]).collect();
-    let mut sorted_answers = vec![empty; rays.len()];
-    let mut start = 0;
-    while start < sorted.len() {
-        let octant = octant(&sorted[start]);
-        let mut end = start + 1;
-        while end < sorted.len() && end - start < PACKET && self::octant(&sorted[end]) == octant {
-            end += 1;
-        }
-        trace(&sorted[start..end], &mut sorted_answers[start..end]);
-        start = end;
+fn packet_end(rays: &[Ray], order: &[u32], start: usize) -> usize {
+    let octant = octant(&rays[order[start] as usize]);
+    let mut end = start + 1;
+    while end < order.len() && end - start < PACKET && self::octant(&rays[order[end] as usize]) == octant {
+        end += 1;
     }
-    for (&i, answer) in order.iter().zip(sorted_answers) {
-        answers[i as usize] = answer;
-    }
+    end
 }
 
 /// Bins per axis of [`by_direction`]'s key.
