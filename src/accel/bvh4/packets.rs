@@ -330,9 +330,9 @@ impl Bvh4 {
             stack,
             #[inline(always)]
             |entry, entered, t_max| {
-                if entry & LEAF == 0 && entered & (entered - 1) == 0 {
+                if goes_alone(entered) {
                     let lane = entered.trailing_zeros() as usize;
-                    let ray_t_max = l.store(*t_max)[lane];
+                    let ray_t_max = l.store(closest.t_max)[lane];
                     if let Some(hit) = self.intersect_below(packet.lanes[lane], entry, ray_t_max, alone) {
                         closest.set(l, lane, hit);
                     }
@@ -445,7 +445,7 @@ impl Bvh4 {
             stack,
             #[inline(always)]
             |entry, mut entered, t_max| {
-                if entry & LEAF == 0 && entered & (entered - 1) == 0 {
+                if goes_alone(entered) {
                     if self.occluded_below(packet.lanes[entered.trailing_zeros() as usize], entry, alone) {
                         found |= entered;
                         *t_max = l.select(l.mask(entered), l.splat(f32::NEG_INFINITY), *t_max);
@@ -485,10 +485,10 @@ impl Bvh4 {
 
     /// Visit the nodes and leaves that the rays of `lanes` (those of `live`) may meet, calling
     /// `visit(its entry, the lanes that entered it, t_max)` for each leaf that several lanes
-    /// enter, and for each node or leaf that one lane enters alone, whose subtree that lane's
-    /// ray traverses alone (`visit`'s part: in a packet, it would test every box and triangle
-    /// in eight lanes for one ray's sake). `visit` may shorten `t_max`, and returns true to end
-    /// the traversal. With `CLOSEST`, children are visited nearest first (for the lowest lane
+    /// enter, and for each node or leaf that one lane enters alone ([`goes_alone`]), whose
+    /// subtree that lane's ray traverses alone (`visit`'s part: in a packet, it would test every
+    /// box and triangle in eight lanes for one ray's sake). `visit` may shorten `t_max`, and
+    /// returns true to end the traversal. With `CLOSEST`, children are visited nearest first (for the lowest lane
     /// that enters any) and entries beyond every entering lane's `t_max` are skipped.
     #[inline(always)]
     fn traverse_packet<L: Lanes8, const CLOSEST: bool>(
@@ -503,7 +503,7 @@ impl Bvh4 {
         stack.clear();
         let (mut current, mut entered) = (ROOT, live);
         loop {
-            if current & LEAF == 0 && entered & (entered - 1) != 0 {
+            if current & LEAF == 0 && !goes_alone(entered) {
                 let node = &self.nodes[current as usize];
                 let tests: [(u32, L::F); 4] = [
                     lanes.enter(l, node, 0, *t_max),
@@ -565,6 +565,13 @@ impl Bvh4 {
             }
         }
     }
+}
+
+/// Whether the one to eight lanes `entered` go on alone from where they are: one lane does
+/// ([`Bvh4::traverse_packet`]).
+#[inline(always)]
+fn goes_alone(entered: u32) -> bool {
+    entered & (entered - 1) == 0
 }
 
 /// A query traced eight rays at a time: its answer per ray, and the packet's traversal.
