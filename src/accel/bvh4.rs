@@ -15,7 +15,8 @@
 //! triangle tests at the leaves, eight rays at a time in SIMD lanes (`intersect_many`).
 //!
 //! The wavefront's bounce and shadow rays are sorted by direction and traced eight at a time,
-//! one per lane, through every node's boxes and every leaf's triangles (`packets.rs`).
+//! one per lane, through every node's boxes and every leaf's triangles (`packets.rs`); a ray
+//! that alone enters a node or leaf goes on from there with its own traversal.
 //!
 //! Leaves whose triangles all emit and lie in one plane (a quad light) keep that plane, and shadow
 //! rays that stay clear of it skip their triangle tests (`leaf_plane.rs`).

@@ -1,7 +1,9 @@
 //! Eight rays traced together through the four-wide BVH, one per lane (Wald et al. 2001,
 //! "Interactive Rendering with Coherent Ray Tracing"; Embree's `rtcIntersect8`): each node's
 //! boxes are tested against the eight rays at once, each triangle of a leaf against the eight
-//! rays at once, so that rays sharing a path through the tree share its cost.
+//! rays at once, so that rays sharing a path through the tree share its cost. Where one ray
+//! alone enters a node or leaf, it goes on from there by itself, four boxes or triangles at a
+//! time, as a single ray is traced (Embree's hybrid traversal).
 //!
 //! The lanes are [`Lanes8`]'s: AVX2 instructions where the CPU has them, a portable twin with the
 //! same bits elsewhere. Each lane runs the operations of the single-ray tests in the same order
