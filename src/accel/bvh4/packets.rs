@@ -308,7 +308,7 @@ impl<L: Lanes8> ClosestLanes<L> {
 }
 
 impl Bvh4 {
-    /// The closest hit of each ray `rays[i]` for `i` in `packet` (one to eight) into `hits[i]`,
+    /// The closest hit of each ray `rays[i]` for `i` in `indices` (one to eight) into `hits[i]`,
     /// as [`Bvh4::intersect`] gives it but for ties in distance; `stacks` is scratch.
     #[inline(always)]
     fn intersect_packet<L: Lanes8>(
@@ -490,8 +490,9 @@ impl Bvh4 {
     /// enter, and for each node or leaf that one lane enters alone ([`goes_alone`]), whose
     /// subtree that lane's ray traverses alone (`visit`'s part: in a packet, it would test every
     /// box and triangle in eight lanes for one ray's sake). `visit` may shorten `t_max`, and
-    /// returns true to end the traversal. With `CLOSEST`, children are visited nearest first (for the lowest lane
-    /// that enters any) and entries beyond every entering lane's `t_max` are skipped.
+    /// returns true to end the traversal. With `CLOSEST`, children are visited nearest first
+    /// (for the lowest lane that enters any) and entries beyond every entering lane's `t_max`
+    /// are skipped.
     #[inline(always)]
     fn traverse_packet<L: Lanes8, const CLOSEST: bool>(
         &self,
