@@ -667,6 +667,8 @@ fn packet_end(rays: &[Ray], order: &[u32], start: usize) -> usize {
 
 /// Bins per axis of [`by_direction`]'s key (a power of two).
 const BINS: usize = 8;
+/// How many keys [`direction_key`] gives: an octant's bins of x by bins of y, for each octant.
+const KEYS: usize = 8 * BINS * BINS;
 
 /// An order of `rays` in which rays of like directions are neighbours, so that packets of
 /// consecutive rays share their way through the tree: a counting sort (stable, so that the
@@ -677,7 +679,7 @@ const BINS: usize = 8;
 /// wavefront's order).
 fn by_direction(rays: &[Ray]) -> Vec<u32> {
     let keys: Vec<u16> = rays.iter().map(direction_key).collect();
-    let mut first = [0u32; 8 * BINS * BINS + 1];
+    let mut first = [0u32; KEYS + 1];
     for &k in &keys {
         first[k as usize + 1] += 1;
     }
@@ -702,7 +704,7 @@ fn direction_key(ray: &Ray) -> u16 {
     ((octant(ray) * BINS + x) * BINS + y) as u16
 }
 
-/// The whole number nearest `x` for `x` in [0, [`BINS`]), read from the low bits of the
+/// The whole number nearest `x` for `x` in [0, [`BINS`] - 1/2), read from the low bits of the
 /// mantissa of `x + 2^23` (which rounds to whole numbers): three instructions, where a
 /// conversion to an integer takes a dozen to saturate. Any other `x` (a NaN or infinite
 /// scale) gives some bin in range too.
@@ -758,7 +760,7 @@ mod tests {
         assert!(seen.iter().copied().eq(0..rays.len() as u32), "a permutation of the rays");
         let keys: Vec<u16> = order.iter().map(|&i| direction_key(&rays[i as usize])).collect();
         assert!(keys.windows(2).all(|k| k[0] <= k[1]), "sorted by key");
-        assert!(keys.iter().all(|&k| (k as usize) < 8 * BINS * BINS));
+        assert!(keys.iter().all(|&k| (k as usize) < KEYS));
         // Stable: equal keys keep the rays' order; octants never interleave.
         for w in order.windows(2) {
             let (a, b) = (&rays[w[0] as usize], &rays[w[1] as usize]);
