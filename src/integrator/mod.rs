@@ -13,9 +13,7 @@ pub use progressive::{Ending, PassLimits, render_in_passes};
 
 use crate::color::Rgb;
 use crate::image::{Aov, Film};
-use crate::sampling::PixelKey;
 use crate::scene::Scene;
-use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -98,7 +96,6 @@ pub fn render_samples(
     progress: &(dyn Fn(u64, u64) + Sync),
     stop: &AtomicBool,
 ) -> Option<Film> {
-    let s = scene.settings;
     let (w, h) = crop.size();
     let stride = film.aov_stride();
     let aovs = film.aovs();
@@ -125,20 +122,8 @@ pub fn render_samples(
         // pixel's samples are added to its sums in order.
         let pixels_per_wave = (WAVE / samples.len().max(1)).max(1);
         for wave in tile_pixels.chunks(pixels_per_wave) {
-            paths.clear();
-            for &(fx, fy) in wave {
-                let (px, py) = (crop.x0 + fx, crop.y0 + fy);
-                let key = PixelKey::new(s.seed, py as u64 * s.width as u64 + px as u64);
-                for i in samples.clone() {
-                    let mut sampler = key.sampler(i);
-                    let film_pos = s.pixel_filter.film_position(px, py, sampler.next_2d());
-                    // A thin lens takes the next two dimensions; other cameras none, so that
-                    // their paths draw the same numbers as before lenses existed.
-                    let lens = if scene.camera.needs_lens_sample() { sampler.next_2d() } else { Vec2::ZERO };
-                    let (ray, diff) = scene.camera.generate_ray(film_pos, lens);
-                    paths.push(tracer.start(ray, diff, sampler));
-                }
-            }
+            let wave_pixels = wave.iter().map(|&(fx, fy)| (crop.x0 + fx, crop.y0 + fy));
+            tracer.start_wave(wave_pixels, samples.clone(), buffers, paths);
             tracer.trace_wave(paths, buffers);
             for (&(fx, fy), pixel_paths) in wave.iter().zip(paths.chunks(samples.len().max(1))) {
                 let mut sum = film.pixel(fx as usize, fy as usize).clone();

@@ -19,7 +19,7 @@ use super::lanes::{LANES, LaneBsdf};
 use crate::accel::Hit;
 use crate::color::Rgb;
 use crate::geometry::{Frame, Ray, RayDifferential, SurfaceInteraction};
-use crate::sampling::{Sampler, power_heuristic};
+use crate::sampling::{PixelKey, Sampler, power_heuristic};
 use crate::scene::Scene;
 use crate::simd::Isa;
 use crate::texture::TexCtx;
@@ -101,6 +101,8 @@ pub(super) struct ShadowTest {
 /// The buffers of [`PathTracer::trace_wave`], kept from one wave to the next.
 #[derive(Default)]
 pub struct WaveBuffers {
+    /// Each camera sample's sampler, film position and lens sample ([`PathTracer::start_wave`]).
+    camera_draws: Vec<(Sampler, Vec2, Vec2)>,
     active: Vec<usize>,
     /// The paths that go on after the current vertex.
     alive: Vec<usize>,
@@ -155,11 +157,45 @@ impl<'a> PathTracer<'a> {
         }
     }
 
+    /// The paths of samples `samples` of each pixel of `pixels` (image coordinates), in that
+    /// order, in `paths` (cleared first): each sample's sampler, the film position and lens
+    /// sample it draws first, and its camera ray. In two passes over the wave, the draws then
+    /// the rays: in one, each sample's hashing, ray and normalisation made one chain of latency
+    /// too long for the processor to overlap with the next sample's.
+    pub fn start_wave(
+        &self,
+        pixels: impl Iterator<Item = (u32, u32)>,
+        samples: std::ops::Range<u32>,
+        buffers: &mut WaveBuffers,
+        paths: &mut Vec<Path>,
+    ) {
+        let (s, camera) = (&self.scene.settings, &self.scene.camera);
+        let draws = &mut buffers.camera_draws;
+        draws.clear();
+        for (px, py) in pixels {
+            let key = PixelKey::new(s.seed, py as u64 * s.width as u64 + px as u64);
+            for i in samples.clone() {
+                let mut sampler = key.sampler(i);
+                let film = s.pixel_filter.film_position(px, py, sampler.next_2d());
+                // A thin lens takes the next two dimensions; other cameras none, so that their
+                // paths draw the same numbers as before lenses existed.
+                let lens = if camera.needs_lens_sample() { sampler.next_2d() } else { Vec2::ZERO };
+                draws.push((sampler, film, lens));
+            }
+        }
+        paths.clear();
+        paths.extend(draws.drain(..).map(|(sampler, film, lens)| {
+            let (ray, diff) = camera.generate_ray(film, lens);
+            self.start(ray, diff, sampler)
+        }));
+    }
+
     /// Trace every path of `paths` (fresh from [`PathTracer::start`]) to its end: trace all
     /// their camera rays, then shade all at their vertices, test all their shadow rays, trace
     /// all their next rays, and again.
     pub fn trace_wave(&self, paths: &mut [Path], buffers: &mut WaveBuffers) {
-        let WaveBuffers { active, alive, lane_groups, shadow, camera_rays, camera_hits, rays, hits, blocked } = buffers;
+        let WaveBuffers { active, alive, lane_groups, shadow, camera_rays, camera_hits, rays, hits, blocked, .. } =
+            buffers;
         lane_groups.resize_with(self.scene.materials.len(), Vec::new);
         // Neighbouring camera rays (a pixel's samples, or neighbouring pixels' in a pass of few
         // samples) are nearly parallel: the accelerator traces them as packets.
