@@ -283,7 +283,7 @@ impl<'a> PathTracer<'a> {
         let Path { ray, diff, hit, sampler, throughput, eta_scale, prev, depth, radiance, first_hit } = path;
         let Some(hit) = *hit else {
             let bsdf_pdf = (!prev.delta).then_some(prev.pdf);
-            *radiance += *throughput * lights.arriving_from_infinity(ray.d.normalize(), bsdf_pdf);
+            *radiance += *throughput * lights.arriving_from_infinity(ray.d, bsdf_pdf);
             return false;
         };
         let shape = scene.shape_of(hit.primitive);

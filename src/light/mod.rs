@@ -203,11 +203,15 @@ impl Lights {
         }
     }
 
-    /// Radiance arriving along unit direction `d` from the lights at infinity (the environment
-    /// and suns), seen by a path that left its last vertex along `d` with BSDF density
-    /// `bsdf_pdf`, weighted against next-event estimation by the power heuristic; None for a
-    /// direction sampled with a delta (the camera's, or a smooth BSDF's): full weight.
-    pub fn arriving_from_infinity(&self, d: Vec3, bsdf_pdf: Option<f32>) -> Rgb {
+    /// Radiance arriving along `direction` (of any length) from the lights at infinity (the
+    /// environment and suns), seen by a path that left its last vertex along it with BSDF
+    /// density `bsdf_pdf`, weighted against next-event estimation by the power heuristic; None
+    /// for a direction sampled with a delta (the camera's, or a smooth BSDF's): full weight. The
+    /// direction is normalised only where a light reads it: a constant sky alone does not, and
+    /// a path that leaves the scene under one spends no square root and division here.
+    pub fn arriving_from_infinity(&self, direction: Vec3, bsdf_pdf: Option<f32>) -> Rgb {
+        let reads_direction = matches!(self.environment, Some(Environment::Map(_))) || !self.distant.is_empty();
+        let d = if reads_direction { direction.normalize() } else { direction };
         let weight =
             |light_pdf: f32| bsdf_pdf.map_or(1.0, |pdf| power_heuristic(pdf, light_pdf * self.selection_pdf()));
         let mut radiance = Rgb::ZERO;
