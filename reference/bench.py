@@ -9,7 +9,8 @@ evaluated procedurally by tessera; Mitsuba renders `tessera export-mitsuba`'s ba
 
 Each round renders each scene once with tessera, once with Mitsuba's llvm_ad_rgb and once with
 its scalar_rgb, one after the other, so that a machine that slows down or speeds up during the
-session affects all three alike; the medians over the rounds are printed with their ratios.
+session affects all three alike; the medians over the rounds are printed with their ratios,
+and each round's ratios, which a machine whose speed drifts over the session affects least.
 With --depths, each round also renders each scene with those path lengths (max_depth: 1 is the
 camera rays and the emitters they see, 2 adds the first vertex's light sample and bounce), and
 the medians are printed as nanoseconds a sample and what each longer path adds: where along the
@@ -146,6 +147,13 @@ def main():
         for k, v in median.items():
             ratio = "" if k == "tessera" else f"   tessera / {k} = {median['tessera'] / v:.2f}x"
             print(f"  {k:<12} {v:7.3f} M samples/s{ratio}")
+        # Each round's renders run seconds apart, so a round's ratio cancels the machine's drift
+        # over the session, which the ratio of medians (above, the headline) does not.
+        for k, v in rates.items():
+            if k != "tessera":
+                paired = sorted(t / m for t, m in zip(rates["tessera"], v))
+                print(f"  tessera / {k} round by round: " + ", ".join(f"{r:.2f}x" for r in paired)
+                      + f" (median {statistics.median(paired):.2f}x)")
         if depths:
             print(f"scene {name} by path length: ns a sample ({args.threads} threads; + what the longer paths add)")
             for renderer, rates_of in by_depth.items():
