@@ -98,7 +98,8 @@ pub(super) struct ShadowTest {
     pub(super) contribution: Rgb,
 }
 
-/// The buffers of [`PathTracer::trace_wave`], kept from one wave to the next.
+/// The buffers of [`PathTracer::start_wave`] and [`PathTracer::trace_wave`], kept from one wave
+/// to the next.
 #[derive(Default)]
 pub struct WaveBuffers {
     /// Each camera sample's sampler, film position and lens sample ([`PathTracer::start_wave`]).
