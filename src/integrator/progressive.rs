@@ -4,7 +4,10 @@
 //! pixel, bit for bit, and the final one that of an uninterrupted render. Passes double in
 //! length from one sample per pixel, bounded by the time left and a longest pass, so that a
 //! time limit is kept and an interruption loses little; a remainder shorter than a pass joins
-//! it (64 samples per pixel: passes of 1, 2, 4, 8, 16 and 33).
+//! it (64 samples per pixel: passes of 1, 2, 4, 8, 16 and 33). A pass after the first lasts at
+//! least [`SHORTEST_PASS`] at the rate so far, where samples remain: each costs a sweep over
+//! every tile, and a short render's passes of a few samples cost it several percent (scene A's
+//! 64 samples per pixel on two cores: passes of 1 and 63).
 
 use super::{Crop, render_samples};
 use crate::image::Film;
@@ -20,6 +23,12 @@ pub struct PassLimits {
     /// Longest pass, estimated from the passes so far (checkpoints are written between passes).
     pub longest_pass: Duration,
 }
+
+/// The shortest pass after the first (where samples remain), at the rate so far: long enough
+/// that what a pass costs beyond its samples (a sweep over every tile and a copy of the film,
+/// some 20 ms for 512 x 512 pixels on two cores) is about 1% of it, short enough that an
+/// interruption loses little more than the half of the work that doubling passes may lose.
+pub const SHORTEST_PASS: Duration = Duration::from_secs(2);
 
 /// Why a render in passes ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,7 +65,9 @@ pub fn render_in_passes(
     let mut film = start_film;
     let (mut done, mut pass) = (resumed, 1u32);
     while done < spp {
-        pass = with_remainder(pass, done, spp);
+        // Seconds a sample per pixel has taken so far, after the first pass.
+        let per_spp = (done > resumed).then(|| start.elapsed().as_secs_f64() / (done - resumed) as f64);
+        pass = pass_length(pass, done, spp, per_spp);
         if let Some(limit) = limits.time_limit {
             // Keep within the limit: no more samples than the time left allows at the rate so far.
             let elapsed = start.elapsed();
@@ -71,8 +82,7 @@ pub fn render_in_passes(
                 return Ok((film, done, Ending::TimeLimit));
             }
         }
-        if done > resumed {
-            let per_spp = start.elapsed().as_secs_f64() / (done - resumed) as f64;
+        if let Some(per_spp) = per_spp {
             pass = pass.min(((limits.longest_pass.as_secs_f64() / per_spp).floor() as u32).max(1));
         }
         let range = done..(done + pass).min(spp);
@@ -87,10 +97,15 @@ pub fn render_in_passes(
     Ok((film, done, Ending::Complete))
 }
 
-/// The length of a pass of `pass` samples per pixel after `done` of `spp`: all that is left when
-/// the remainder after it would be shorter than it. A pass of a few samples per pixel costs
-/// more than its share (a sweep over every tile, camera packets of few rays).
-fn with_remainder(pass: u32, done: u32, spp: u32) -> u32 {
+/// The length of the pass after `done` of `spp` samples per pixel, doubled to `doubled`, before
+/// the time limit and the longest pass bound it: at least what fills [`SHORTEST_PASS`] at
+/// `per_spp` seconds a sample per pixel (where that is known), and all that is left when the
+/// remainder after it would be shorter than it. A pass of a few samples per pixel costs more
+/// than its share (a sweep over every tile, camera packets of few rays).
+fn pass_length(doubled: u32, done: u32, spp: u32, per_spp: Option<f64>) -> u32 {
+    // Saturating float-to-integer conversion: a rate of 0 or NaN gives u32::MAX or 0.
+    let filling = per_spp.map_or(0, |per_spp| (SHORTEST_PASS.as_secs_f64() / per_spp).floor() as u32);
+    let pass = doubled.max(filling);
     let left = spp - done;
     if left < pass.saturating_mul(2) { left } else { pass }
 }
@@ -99,11 +114,12 @@ fn with_remainder(pass: u32, done: u32, spp: u32) -> u32 {
 mod tests {
     use super::*;
 
-    /// The pass lengths of a render of `spp` samples per pixel without limits.
-    fn schedule(spp: u32) -> Vec<u32> {
+    /// The pass lengths of a render of `spp` samples per pixel without limits, a sample per
+    /// pixel taking `per_spp` seconds.
+    fn schedule(spp: u32, per_spp: f64) -> Vec<u32> {
         let (mut done, mut pass, mut lengths) = (0, 1u32, Vec::new());
         while done < spp {
-            pass = with_remainder(pass, done, spp);
+            pass = pass_length(pass, done, spp, (done > 0).then_some(per_spp));
             lengths.push(pass);
             done += pass;
             pass = pass.saturating_mul(2);
@@ -113,11 +129,25 @@ mod tests {
 
     #[test]
     fn passes_double_and_a_short_remainder_joins_the_last() {
-        assert_eq!(schedule(1), [1]);
-        assert_eq!(schedule(6), [1, 2, 3]);
-        assert_eq!(schedule(64), [1, 2, 4, 8, 16, 33]);
-        assert_eq!(schedule(100), [1, 2, 4, 8, 16, 32, 37]);
-        assert_eq!(schedule(127), [1, 2, 4, 8, 16, 32, 64]);
-        assert_eq!(schedule(u32::MAX).iter().map(|&p| p as u64).sum::<u64>(), u32::MAX as u64);
+        // Slow samples (a minute a sample per pixel): doubling alone.
+        assert_eq!(schedule(1, 60.0), [1]);
+        assert_eq!(schedule(6, 60.0), [1, 2, 3]);
+        assert_eq!(schedule(64, 60.0), [1, 2, 4, 8, 16, 33]);
+        assert_eq!(schedule(100, 60.0), [1, 2, 4, 8, 16, 32, 37]);
+        assert_eq!(schedule(127, 60.0), [1, 2, 4, 8, 16, 32, 64]);
+        assert_eq!(schedule(u32::MAX, 60.0).iter().map(|&p| p as u64).sum::<u64>(), u32::MAX as u64);
+    }
+
+    #[test]
+    fn passes_after_the_first_fill_the_shortest_pass() {
+        // Scene A's rate on two cores (about 40 ms a sample per pixel): two seconds of samples,
+        // which the rest joins; the first pass stays one sample per pixel.
+        assert_eq!(schedule(64, 0.04), [1, 63]);
+        assert_eq!(schedule(1024, 0.04), [1, 50, 100, 200, 673]);
+        assert_eq!(schedule(1024, 0.5), [1, 4, 8, 16, 32, 64, 128, 256, 515]);
+        // Samples so fast that a second holds them all; a rate of zero or NaN does not panic.
+        assert_eq!(schedule(1_000_000, 1e-9), [1, 999_999]);
+        assert_eq!(schedule(64, 0.0), [1, 63]);
+        assert_eq!(schedule(64, f64::NAN), [1, 2, 4, 8, 16, 33]);
     }
 }
