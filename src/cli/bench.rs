@@ -328,16 +328,33 @@ fn render_scene_a(scene_dir: &Path, runs: usize, pool: &rayon::ThreadPool) -> Re
 
 /// Lookups per second (millions) of `texture` over `lookups`, median of `runs`.
 fn lookups_per_second(runs: usize, texture: &Texture, lookups: &[TexCtx]) -> f64 {
-    median(
-        (0..runs)
-            .map(|_| {
-                let start = Instant::now();
-                let sum: f32 = lookups.iter().map(|ctx| texture.eval(std::hint::black_box(ctx)).x).sum();
-                std::hint::black_box(sum);
-                lookups.len() as f64 / start.elapsed().as_secs_f64() / 1e6
-            })
-            .collect(),
-    )
+    median((0..runs).map(|_| lookup_rate(texture, lookups)).collect())
+}
+
+/// Lookups per second (millions) of `texture` over `lookups`, once.
+fn lookup_rate(texture: &Texture, lookups: &[TexCtx]) -> f64 {
+    let start = Instant::now();
+    let sum: f32 = lookups.iter().map(|ctx| texture.eval(std::hint::black_box(ctx)).x).sum();
+    std::hint::black_box(sum);
+    lookups.len() as f64 / start.elapsed().as_secs_f64() / 1e6
+}
+
+/// Each texture's lookups per second (millions) over `lookups` in `runs` alternating rounds (a
+/// round times each texture once, one after the other): per texture, the rate of each round.
+/// Ratios taken round by round cancel a machine whose speed drifts over the benchmark.
+fn lookup_rates_alternating(runs: usize, textures: &[&Texture], lookups: &[TexCtx]) -> Vec<Vec<f64>> {
+    let mut rates = vec![Vec::with_capacity(runs); textures.len()];
+    for _ in 0..runs {
+        for (texture, rates) in textures.iter().zip(&mut rates) {
+            rates.push(lookup_rate(texture, lookups));
+        }
+    }
+    rates
+}
+
+/// The median over rounds of the ratio `numerator[r] / denominator[r]`.
+fn median_ratio(numerator: &[f64], denominator: &[f64]) -> f64 {
+    median(numerator.iter().zip(denominator).map(|(n, d)| n / d).collect())
 }
 
 fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
@@ -369,14 +386,13 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
             TexCtx { uv, duv_dx: dx, duv_dy: dx.perp() * (0.3 + 0.7 * s.next_1d()), uv_mirrored: None }
         })
         .collect();
-    let bitmap = lookups_per_second(runs, &exemplar, &lookups);
-    println!("textures   {} lookups on 1 thread, exemplar {} (trilinear):", lookups.len(), file.display());
-    println!("           bitmap                         {bitmap:7.2} M lookups/s  (1.00x the bitmap's cost)");
     let blends = [
         ("linear", Blend::Linear),
         ("mix-max", Blend::MixMax { priority: PriorityMap::new(image), contrast: 4.0, lambda: 0.05 }),
     ];
-    for (name, blend) in blends {
+    // Per blend, the classical and the deformed synthesis.
+    let mut syntheses = Vec::new();
+    for (name, blend) in &blends {
         let synthesis = |deformation: Option<DeformationField>| {
             let s = Synthesis {
                 tiling: Tiling::Hexagonal,
@@ -391,16 +407,36 @@ fn textures(scene_dir: &Path, runs: usize) -> Result<()> {
                 .map(Texture::TilingBlending)
                 .map_err(|e| Error::param("bench", e))
         };
-        let classical = lookups_per_second(runs, &synthesis(None)?, &lookups);
-        let deformed = lookups_per_second(runs, &synthesis(Some(deformation.clone()))?, &lookups);
+        syntheses.push((name, synthesis(None)?, synthesis(Some(deformation.clone()))?));
+    }
+    let mut textures = vec![exemplar.as_ref()];
+    for (_, classical, deformed) in &syntheses {
+        textures.extend([classical, deformed]);
+    }
+    let rates = lookup_rates_alternating(runs, &textures, &lookups);
+    let bitmap = &rates[0];
+    println!(
+        "textures   {} lookups on 1 thread, exemplar {} (trilinear), {runs} alternating rounds: medians, and \
+         costs as medians of each round's ratio:",
+        lookups.len(),
+        file.display()
+    );
+    println!(
+        "           bitmap                         {:7.2} M lookups/s  (1.00x the bitmap's cost)",
+        median(bitmap.clone())
+    );
+    for ((name, _, _), rates) in syntheses.iter().zip(rates[1..].chunks(2)) {
+        let [classical, deformed] = rates else { unreachable!("two syntheses a blend") };
         println!(
-            "           classical T&B, {name:<8}        {classical:7.2} M lookups/s  ({:.2}x the bitmap's cost)",
-            bitmap / classical
+            "           classical T&B, {name:<8}        {:7.2} M lookups/s  ({:.2}x the bitmap's cost)",
+            median(classical.clone()),
+            median_ratio(bitmap, classical)
         );
         println!(
-            "           deformed T&B (F map), {name:<8} {deformed:7.2} M lookups/s  ({:.2}x the bitmap's cost, {:.2}x classical; targets 4x, 1.3x)",
-            bitmap / deformed,
-            classical / deformed
+            "           deformed T&B (F map), {name:<8} {:7.2} M lookups/s  ({:.2}x the bitmap's cost, {:.2}x classical; targets 4x, 1.3x)",
+            median(deformed.clone()),
+            median_ratio(bitmap, deformed),
+            median_ratio(classical, deformed)
         );
     }
     Ok(())
