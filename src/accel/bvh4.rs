@@ -38,7 +38,7 @@ use super::leaf_plane::LeafPlane;
 use super::watertight::{PacketHit, RayShear, TrianglePacket};
 use super::{Hit, TraversalStack};
 use crate::geometry::Ray;
-use crate::simd::{Lanes8, set_bits};
+use crate::simd::Lanes8;
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
 
@@ -272,7 +272,7 @@ fn octant(ray: &Ray) -> usize {
 /// The rays of `rays` (at most 32), grouped into packets that [`PacketBoxes`] bounds tightly:
 /// one octant, directions within `COHERENT_COS` of the group's first; each group a bit mask.
 fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
-    debug_assert!(rays.len() <= 32);
+    debug_assert!(rays.len() <= PACKET_SIZE);
     let mut by_octant = [0u32; 8];
     for (i, r) in rays.iter().enumerate() {
         by_octant[octant(r)] |= 1 << i;
@@ -289,19 +289,17 @@ fn coherent_groups(rays: &[Ray]) -> impl Iterator<Item = u32> {
             }
             let remaining = by_octant[octant];
             let first = remaining.trailing_zeros() as usize;
-            let mut group = 1u32 << first;
             let d = rays[first].d;
-            // d_i . d >= COHERENT_COS |d_i| |d|, squared (in one octant, d_i . d is not negative).
+            // d_i . d >= COHERENT_COS |d_i| |d|, squared (in one octant, d_i . d is not negative),
+            // tested for every ray without a branch, then kept for those of the octant. (At most
+            // PACKET_SIZE rays: a group never exceeds it.)
             let bound = COHERENT_COS * COHERENT_COS * d.length_squared();
-            for i in set_bits(remaining & (remaining - 1)) {
-                if group.count_ones() == PACKET_SIZE as u32 {
-                    break;
-                }
-                let dot = rays[i].d.dot(d);
-                if dot * dot >= bound * rays[i].d.length_squared() {
-                    group |= 1 << i;
-                }
+            let mut near = 0u32;
+            for (i, r) in rays.iter().enumerate() {
+                let dot = r.d.dot(d);
+                near |= u32::from(dot * dot >= bound * r.d.length_squared()) << i;
             }
+            let group = (near & remaining) | (1 << first);
             by_octant[octant] &= !group;
             Some(group)
         },

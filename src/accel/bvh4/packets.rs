@@ -392,7 +392,7 @@ impl Bvh4 {
             |leaf, packet_t_max| {
                 let index = (leaf & LEAF_INDEX) as usize;
                 let bounds = &self.leaves[index].bounds;
-                let mut farthest = 0.0f32;
+                let mut farthest = l.splat(0.0);
                 for (rays, closest) in lanes.iter_mut() {
                     let (entered, _) = rays.enter_box(
                         l,
@@ -403,9 +403,9 @@ impl Bvh4 {
                     if entered != 0 {
                         closest.test(l, rays, &self.packets[index], entered);
                     }
-                    farthest = l.store(closest.t_max).iter().fold(farthest, |a, &b| a.max(b));
+                    farthest = l.max(farthest, closest.t_max);
                 }
-                *packet_t_max = farthest;
+                *packet_t_max = l.store(farthest).iter().fold(0.0f32, |a, &b| a.max(b));
                 false
             },
         );
