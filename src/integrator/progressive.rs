@@ -26,9 +26,11 @@ pub struct PassLimits {
 
 /// The shortest pass after the first (where samples remain), at the rate so far: long enough
 /// that what a pass costs beyond its samples (a sweep over every tile and a copy of the film,
-/// some 20 ms for 512 x 512 pixels on two cores) is about 1% of it, short enough that an
+/// some 20-40 ms for 512 x 512 pixels on two cores) is about 1% of it, short enough that an
 /// interruption loses little more than the half of the work that doubling passes may lose.
-pub const SHORTEST_PASS: Duration = Duration::from_secs(2);
+/// The rate after the first pass is pessimistic (a pass of one sample per pixel takes up to
+/// twice a sample's share), so this is some two seconds of samples.
+pub const SHORTEST_PASS: Duration = Duration::from_secs(3);
 
 /// Why a render in passes ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -140,11 +142,11 @@ mod tests {
 
     #[test]
     fn passes_after_the_first_fill_the_shortest_pass() {
-        // Scene A's rate on two cores (about 40 ms a sample per pixel): two seconds of samples,
-        // which the rest joins; the first pass stays one sample per pixel.
+        // Scene A's rate on two cores (about 40 ms a sample per pixel): three seconds of
+        // samples, which the rest joins; the first pass stays one sample per pixel.
         assert_eq!(schedule(64, 0.04), [1, 63]);
-        assert_eq!(schedule(1024, 0.04), [1, 50, 100, 200, 673]);
-        assert_eq!(schedule(1024, 0.5), [1, 4, 8, 16, 32, 64, 128, 256, 515]);
+        assert_eq!(schedule(1024, 0.04), [1, 75, 150, 300, 498]);
+        assert_eq!(schedule(1024, 0.5), [1, 6, 12, 24, 48, 96, 192, 645]);
         // Samples so fast that a second holds them all; a rate of zero or NaN does not panic.
         assert_eq!(schedule(1_000_000, 1e-9), [1, 999_999]);
         assert_eq!(schedule(64, 0.0), [1, 63]);
