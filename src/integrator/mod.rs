@@ -96,10 +96,26 @@ pub fn render_samples(
     progress: &(dyn Fn(u64, u64) + Sync),
     stop: &AtomicBool,
 ) -> Option<Film> {
+    render_samples_into(scene, crop, film, film.clone(), samples, progress, stop).ok()
+}
+
+/// [`render_samples`], writing every pixel of the new film into `into` (a film of `film`'s
+/// size and AOVs, whatever it holds: a spare one is reused rather than a copy of 20 MB made at
+/// each pass); `into` back, its pixels partly written, where `stop` ends the pass.
+pub fn render_samples_into(
+    scene: &Scene,
+    crop: Crop,
+    film: &Film,
+    into: Film,
+    samples: std::ops::Range<u32>,
+    progress: &(dyn Fn(u64, u64) + Sync),
+    stop: &AtomicBool,
+) -> Result<Film, Film> {
     let (w, h) = crop.size();
     let stride = film.aov_stride();
     let aovs = film.aovs();
-    let next = Mutex::new(film.clone());
+    assert!(into.resolution() == film.resolution() && into.aovs() == aovs, "a spare film of another size or AOVs");
+    let next = Mutex::new(into);
     let tracer = PathTracer::new(scene, !aovs.is_empty(), aovs.contains(&Aov::Footprint));
     let spp = samples.len() as u64;
     let total = w as u64 * h as u64 * spp;
@@ -144,6 +160,6 @@ pub fn render_samples(
         }
         progress(done.fetch_add(taken, Ordering::Relaxed) + taken, total);
     });
-    let complete = done.load(Ordering::Relaxed) == total;
-    complete.then(|| next.into_inner().expect("no panics while holding the film"))
+    let next = next.into_inner().expect("no panics while holding the film");
+    if done.load(Ordering::Relaxed) == total { Ok(next) } else { Err(next) }
 }

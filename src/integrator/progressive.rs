@@ -1,5 +1,5 @@
 //! A render in passes (`tessera render --time-limit / --checkpoint`, Ctrl-C): samples 0..spp of
-//! every pixel split into consecutive ranges, each rendered by [`render_samples`] onto the
+//! every pixel split into consecutive ranges, each rendered by [`render_samples_into`] onto the
 //! previous pass's film, so that the image after any pass is the image of that many samples per
 //! pixel, bit for bit, and the final one that of an uninterrupted render. Passes double in
 //! length from one sample per pixel, bounded by the time left and a longest pass, so that a
@@ -9,7 +9,7 @@
 //! every tile, and a short render's passes of a few samples cost it several percent (scene A's
 //! 64 samples per pixel on two cores: passes of 1 and 63).
 
-use super::{Crop, render_samples};
+use super::{Crop, render_samples_into};
 use crate::image::Film;
 use crate::scene::Scene;
 use std::sync::atomic::AtomicBool;
@@ -64,7 +64,7 @@ pub fn render_in_passes(
     let resumed = start_film.samples_per_pixel().unwrap_or(0);
     let total = per_pass_sample * spp.saturating_sub(resumed) as u64;
     let start = Instant::now();
-    let mut film = start_film;
+    let (mut film, mut spare) = (start_film, None);
     let (mut done, mut pass) = (resumed, 1u32);
     while done < spp {
         // Seconds a sample per pixel has taken so far, after the first pass.
@@ -89,9 +89,13 @@ pub fn render_in_passes(
         }
         let range = done..(done + pass).min(spp);
         let base = per_pass_sample * (done - resumed) as u64;
-        let next = render_samples(scene, crop, &film, range.clone(), &|d, _| progress(base + d, total), stop);
-        let Some(next) = next else { return Ok((film, done, Ending::Stopped)) };
-        film = next;
+        // The film two passes old is rewritten whole by the next pass (a copy of the film
+        // for each pass cost as much as 1% of a short render in page faults).
+        let into = spare.take().unwrap_or_else(|| film.clone());
+        let next =
+            render_samples_into(scene, crop, &film, into, range.clone(), &|d, _| progress(base + d, total), stop);
+        let Ok(next) = next else { return Ok((film, done, Ending::Stopped)) };
+        spare = Some(std::mem::replace(&mut film, next));
         done = range.end;
         after_pass(&film, done)?;
         pass = pass.saturating_mul(2);
