@@ -67,21 +67,22 @@ pub fn render_in_passes(
     let (mut film, mut spare) = (start_film, None);
     let (mut done, mut pass) = (resumed, 1u32);
     while done < spp {
-        // Seconds a sample per pixel has taken so far, after the first pass.
-        let per_spp = (done > resumed).then(|| start.elapsed().as_secs_f64() / (done - resumed) as f64);
+        // The time so far, and the seconds a sample per pixel has taken after the first pass.
+        let elapsed = start.elapsed();
+        let per_spp = (done > resumed).then(|| elapsed.as_secs_f64() / (done - resumed) as f64);
         pass = pass_length(pass, done, spp, per_spp);
         if let Some(limit) = limits.time_limit {
             // Keep within the limit: no more samples than the time left allows at the rate so far.
-            let elapsed = start.elapsed();
-            if done > resumed {
-                let per_spp = elapsed.as_secs_f64() / (done - resumed) as f64;
-                let room = ((limit.saturating_sub(elapsed)).as_secs_f64() / per_spp).floor();
-                if room < 1.0 {
-                    return Ok((film, done, Ending::TimeLimit));
+            match per_spp {
+                Some(per_spp) => {
+                    let room = ((limit.saturating_sub(elapsed)).as_secs_f64() / per_spp).floor();
+                    if room < 1.0 {
+                        return Ok((film, done, Ending::TimeLimit));
+                    }
+                    pass = pass.min(room as u32);
                 }
-                pass = pass.min(room as u32);
-            } else if elapsed >= limit {
-                return Ok((film, done, Ending::TimeLimit));
+                None if elapsed >= limit => return Ok((film, done, Ending::TimeLimit)),
+                None => {}
             }
         }
         if let Some(per_spp) = per_spp {
