@@ -5,7 +5,7 @@
 
 use crate::image::Bitmap;
 use crate::math::{ceil, floor, floor_index, floor_x4, floor2, int_x4, wrap_index};
-use glam::{IVec4, Vec2, Vec4};
+use glam::{IVec4, Mat4, Vec2, Vec4};
 
 /// How an image texture is filtered over the hit's footprint.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
@@ -242,10 +242,47 @@ impl BilinearTapsX4 {
         }
     }
 
+    /// [`BilinearTapsX4::read_channels`] of both channels of a two-channel `level`, bit for bit,
+    /// a texel pair a load: each lane's two texels of a row side by side in one vector (the
+    /// first column's two channels, then the second's), the four lanes' vectors transposed into
+    /// a vector per column and channel.
+    #[inline(always)]
+    fn read_two_channels(&self, level: &Bitmap) -> [Vec4; 2] {
+        debug_assert_eq!(level.channels, 2);
+        let ([t00, t10], [t01, t11]) = (self.row_of_two_channels(level, 0), self.row_of_two_channels(level, 1));
+        let (fx, gx, fy, gy) = (self.fx, Vec4::ONE - self.fx, self.fy, Vec4::ONE - self.fy);
+        let blend = |c: usize| (t00[c] * gx + t10[c] * fx) * gy + (t01[c] * gx + t11[c] * fx) * fy;
+        [blend(0), blend(1)]
+    }
+
+    /// Row `r` (0 or 1) of [`BilinearTapsX4::read_two_channels`]: at its first column and at
+    /// its second, the two channels of each lane's texel.
+    #[inline(always)]
+    fn row_of_two_channels(&self, level: &Bitmap, r: usize) -> [[Vec4; 2]; 2] {
+        let (texels, _) = level.data.as_chunks::<2>();
+        let start = self.y[r] * IVec4::splat(level.width as i32);
+        let (first, second) = ((start + self.x[0]).to_array(), (start + self.x[1]).to_array());
+        let m = Mat4::from_cols(
+            texel_pair(texels, first[0], second[0]),
+            texel_pair(texels, first[1], second[1]),
+            texel_pair(texels, first[2], second[2]),
+            texel_pair(texels, first[3], second[3]),
+        )
+        .transpose();
+        [[m.x_axis, m.y_axis], [m.z_axis, m.w_axis]]
+    }
+
     /// The bilinear blend, in lanes, of channels `picks` of `level` (`C` channels a texel) at
     /// each lane's four texels, a vector per pick.
     #[inline(always)]
     fn read_channels<const C: usize, const N: usize>(&self, level: &Bitmap, picks: [usize; N]) -> [Vec4; N] {
+        // Both channels of a two-channel level (Mix-Max's priority map): a load per texel pair.
+        if C == 2 && N == 2 && picks[..] == [0, 1] {
+            let [first, second] = self.read_two_channels(level);
+            let mut both = [Vec4::ZERO; N];
+            (both[0], both[1]) = (first, second);
+            return both;
+        }
         let width = IVec4::splat(level.width as i32);
         let (row0, row1) = (self.y[0] * width, self.y[1] * width);
         // A texel as one `[f32; C]`: one bounds check and one load each.
@@ -278,6 +315,14 @@ fn wrapped_texels_x4(st: Vec4, n: f32) -> ([IVec4; 2], Vec4) {
     let first = Vec4::select(first.cmplt(Vec4::ZERO), first + n, first);
     let second = Vec4::select(second.cmpge(n), second - n, second);
     ([int_x4(first), int_x4(second)], x - floor)
+}
+
+/// The two channels of a two-channel level's texels at `first` and `second` (row-major
+/// indices), side by side.
+#[inline(always)]
+fn texel_pair(texels: &[[f32; 2]], first: i32, second: i32) -> Vec4 {
+    let (a, b) = (texels[first as usize], texels[second as usize]);
+    Vec4::new(a[0], a[1], b[0], b[1])
 }
 
 /// Channels `picks` of the texels at `offsets` (row-major indices, a texel per lane) of a
