@@ -185,13 +185,9 @@ impl Blend {
 #[inline]
 fn win_probability(difference: f32, variance: f32) -> f32 {
     if difference * difference > DECIDED_SQUARED_SIGMAS * variance || !(variance > 0.0) {
-        if difference > 0.0 {
-            1.0
-        } else if difference < 0.0 {
-            0.0
-        } else {
-            0.5
-        }
+        // 1, 0 or 1/2 (a tie, or NaN) without a branch: which tile wins is a coin toss to the
+        // branch predictor.
+        0.5 + 0.5 * ((difference > 0.0) as i32 - (difference < 0.0) as i32) as f32
     } else {
         crate::math::normal_cdf_f32(difference / variance.sqrt())
     }
@@ -212,7 +208,26 @@ pub(super) fn mix_max_weights(
     contrast: f32,
     lambda: f32,
 ) -> [f32; MAX_LOOKUPS] {
-    let k = lookups.len();
+    // The pavings' three and four tiles with loops of a constant length, which LLVM unrolls:
+    // a loop's branches of varying length mispredict among the duels' own.
+    let w = match lookups.len() {
+        3 => duels::<3>(lookups, moments, contrast, lambda),
+        4 => duels::<4>(lookups, moments, contrast, lambda),
+        _ => duels::<MAX_LOOKUPS>(lookups, moments, contrast, lambda),
+    };
+    normalised(w, lookups)
+}
+
+/// The unnormalised weights of [`mix_max_weights`] of `lookups`, of which there are at most
+/// `K` (the loops' bound, a constant where the caller matched the count).
+#[inline(always)]
+fn duels<const K: usize>(
+    lookups: &[TileLookup],
+    moments: &[(f32, f32)],
+    contrast: f32,
+    lambda: f32,
+) -> [f32; MAX_LOOKUPS] {
+    let k = lookups.len().min(K);
     let mut score = [f32::NEG_INFINITY; MAX_LOOKUPS];
     let mut variance = [0.0; MAX_LOOKUPS];
     let mut w = [0.0; MAX_LOOKUPS];
@@ -231,7 +246,7 @@ pub(super) fn mix_max_weights(
             w[j] *= 1.0 - p;
         }
     }
-    normalised(w, lookups)
+    w
 }
 
 /// Weights `w` of `lookups` divided by their sum; the paving's weights where every tile lost
