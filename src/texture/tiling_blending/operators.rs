@@ -208,8 +208,8 @@ pub(super) fn mix_max_weights(
     contrast: f32,
     lambda: f32,
 ) -> [f32; MAX_LOOKUPS] {
-    // The pavings' three and four tiles with loops of a constant length, which LLVM unrolls:
-    // a loop's branches of varying length mispredict among the duels' own.
+    // The pavings' three and four tiles in loops of a constant length, unrolled: loops of a
+    // varying length mispredict among the duels' own branches.
     let w = match lookups.len() {
         3 => duels::<3>(lookups, moments, contrast, lambda),
         4 => duels::<4>(lookups, moments, contrast, lambda),
@@ -219,7 +219,8 @@ pub(super) fn mix_max_weights(
 }
 
 /// The unnormalised weights of [`mix_max_weights`] of `lookups`, of which there are at most
-/// `K` (the loops' bound, a constant where the caller matched the count).
+/// `K`: loops over the constant `K` tiles and their pairs, which LLVM unrolls, tiles beyond
+/// `lookups` left out like dead ones.
 #[inline(always)]
 fn duels<const K: usize>(
     lookups: &[TileLookup],
@@ -227,23 +228,26 @@ fn duels<const K: usize>(
     contrast: f32,
     lambda: f32,
 ) -> [f32; MAX_LOOKUPS] {
-    let k = lookups.len().min(K);
     let mut score = [f32::NEG_INFINITY; MAX_LOOKUPS];
     let mut variance = [0.0; MAX_LOOKUPS];
     let mut w = [0.0; MAX_LOOKUPS];
     // Tiles of weight 0 (outside a cut band's reach) take no part.
-    let live = |i: usize| lookups[i].weight > 0.0;
-    for i in (0..k).filter(|&i| live(i)) {
-        let (s, var) = moments[i];
-        score[i] = contrast * s + lookups[i].weight.ln();
-        variance[i] = contrast * contrast * var;
-        w[i] = 1.0;
+    let live = |i: usize| lookups.get(i).is_some_and(|l| l.weight > 0.0);
+    for i in 0..K {
+        if live(i) {
+            let (s, var) = moments[i];
+            score[i] = contrast * s + lookups[i].weight.ln();
+            variance[i] = contrast * contrast * var;
+            w[i] = 1.0;
+        }
     }
-    for i in (0..k).filter(|&i| live(i)) {
-        for j in (i + 1..k).filter(|&j| live(j)) {
-            let p = win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda);
-            w[i] *= p;
-            w[j] *= 1.0 - p;
+    for i in 0..K {
+        for j in i + 1..K {
+            if live(i) && live(j) {
+                let p = win_probability(score[i] - score[j], variance[i] + variance[j] + 2.0 * lambda * lambda);
+                w[i] *= p;
+                w[j] *= 1.0 - p;
+            }
         }
     }
     w
