@@ -276,13 +276,6 @@ impl BilinearTapsX4 {
     /// each lane's four texels, a vector per pick.
     #[inline(always)]
     fn read_channels<const C: usize, const N: usize>(&self, level: &Bitmap, picks: [usize; N]) -> [Vec4; N] {
-        // Both channels of a two-channel level (Mix-Max's priority map): a load per texel pair.
-        if C == 2 && N == 2 && picks[..] == [0, 1] {
-            let [first, second] = self.read_two_channels(level);
-            let mut both = [Vec4::ZERO; N];
-            (both[0], both[1]) = (first, second);
-            return both;
-        }
         let width = IVec4::splat(level.width as i32);
         let (row0, row1) = (self.y[0] * width, self.y[1] * width);
         // A texel as one `[f32; C]`: one bounds check and one load each.
@@ -315,6 +308,17 @@ fn wrapped_texels_x4(st: Vec4, n: f32) -> ([IVec4; 2], Vec4) {
     let first = Vec4::select(first.cmplt(Vec4::ZERO), first + n, first);
     let second = Vec4::select(second.cmpge(n), second - n, second);
     ([int_x4(first), int_x4(second)], x - floor)
+}
+
+/// The blend of two adjacent levels' values in lanes, the upper weighing `t`: as
+/// [`MipMap::gather`] blends a lookup's two levels.
+#[inline(always)]
+fn between_levels<const N: usize>(lower: [Vec4; N], upper: [Vec4; N], t: f32) -> [Vec4; N] {
+    let mut blended = lower;
+    for (b, u) in blended.iter_mut().zip(upper) {
+        *b = *b * (1.0 - t) + u * t;
+    }
+    blended
 }
 
 /// The two channels of a two-channel level's texels at `first` and `second` (row-major
@@ -536,7 +540,14 @@ impl MipMap {
     #[inline(always)]
     pub fn gather_two_channels_x4(&self, taps: &TapsX4) -> [Vec4; 2] {
         assert_eq!(self.levels[0].channels, 2, "a two-channel gather of a {}-channel pyramid", self.levels[0].channels);
-        self.gather_channels_x4::<2, 2>(taps, [0, 1])
+        #[cfg(debug_assertions)]
+        assert_eq!(taps.base, (self.levels[0].width, self.levels[0].height), "taps of another layout");
+        // A load per texel pair ([`BilinearTapsX4::read_two_channels`]).
+        let lower = taps.lower.read_two_channels(&self.levels[taps.lower.level]);
+        match taps.upper {
+            None => lower,
+            Some((upper, t)) => between_levels(lower, upper.read_two_channels(&self.levels[upper.level]), t),
+        }
     }
 
     /// The red, green and blue of this pyramid filtered at each lane of `taps`, a vector per
@@ -562,14 +573,7 @@ impl MipMap {
         let lower = taps.lower.read_channels::<C, N>(&self.levels[taps.lower.level], picks);
         match taps.upper {
             None => lower,
-            Some((upper, t)) => {
-                let upper = upper.read_channels::<C, N>(&self.levels[upper.level], picks);
-                let mut blended = lower;
-                for (b, u) in blended.iter_mut().zip(upper) {
-                    *b = *b * (1.0 - t) + u * t;
-                }
-                blended
-            }
+            Some((upper, t)) => between_levels(lower, upper.read_channels::<C, N>(&self.levels[upper.level], picks), t),
         }
     }
 
